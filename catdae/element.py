@@ -449,12 +449,19 @@ class Elements:
         if self.loads.n != n:
             raise ValueError(f"loads are given for {self.loads.n} elements, expected {n}")
         self._ls = np.ascontiguousarray(self.loads.s, float)
-        self._lf = np.ascontiguousarray(self.loads.f, float).reshape(-1, 3)
+        self._lf = np.array(self.loads.f, float, copy=True).reshape(-1, 3)
         self._ptr = np.ascontiguousarray(self.loads.ptr, np.int64)
+        self._load_total = self.loads.total()  # (n, 3) N
 
     @property
     def n(self) -> int:
         return self.L0.size
+
+    def set_load_forces(self, f) -> None:
+        """Replace the forces of the loads inside the elements (positions unchanged), (m, 3) N."""
+        self._lf[:] = np.asarray(f, float).reshape(-1, 3)
+        self.loads = PointLoads(self._ptr, self._ls, self._lf)
+        self._load_total = self.loads.total()
 
     def _s(self, s) -> np.ndarray:
         s = np.asarray(s, float)
@@ -536,7 +543,7 @@ class Elements:
         h = self._h(h)
         r = np.empty((self.n, 2, 3))
         r[:, 0] = -h
-        r[:, 1] = h - self.loads.total()
+        r[:, 1] = h - self._load_total
         r[:, 1, 2] += self.w * self.L0
         return r
 

@@ -1,0 +1,333 @@
+"""DOF map, loading of a step, and sparse scatter of element vectors and matrices.
+
+Degrees of freedom are node-major: dof = 3 * node + axis. A :class:`Model` is what one analysis
+step sees: the mesh, the point masses and loads that are active in it (``remove`` takes some
+away), the supports and their prescribed motion. It contains only what the scene has: no time
+functions when no load varies, no internal loads when none sit inside an element.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from .case import Case
+from .element import Elements, ElementState, PointLoads
+from .mesh import AXES, Mesh
+from .timefunc import TimeFunction
+
+
+class Pattern:
+    """CSR sparsity of element 6x6 blocks plus the diagonal, with a scatter map.
+
+    ``edofs`` (n_elem, 6) holds row/column numbers in ``0..n-1`` or -1 for entries to drop.
+    ``assemble(blocks, diag)`` sums (n_elem, 6, 6) blocks and an (n,) diagonal into the data
+    array in one bincount: no Python loop over elements.
+    """
+
+    def __init__(self, edofs: np.ndarray, n: int):
+        r = np.repeat(edofs, 6, axis=1)  # (n_elem, 36)
+        c = np.tile(edofs, (1, 6))
+        keep = (r >= 0) & (c >= 0)
+        keys_e = np.where(keep, r * n + c, -1).ravel()
+        diag = np.arange(n, dtype=np.int64) * (n + 1)
+        keys, inv = np.unique(np.concatenate([keys_e[keys_e >= 0], diag]), return_inverse=True)
+        self.n = n
+        self.nnz = keys.size
+        self.indices = (keys % n).astype(np.int32)
+        rows = keys // n
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))]).astype(
+            np.int32)
+        n_e = int((keys_e >= 0).sum())
+        self._emap_full = np.full(keys_e.size, self.nnz, np.int64)  # dropped -> dump slot
+        self._emap_full[keys_e >= 0] = inv[:n_e]
+        self._dmap = inv[n_e:]
+
+    def assemble(self, blocks: np.ndarray | None = None, diag: np.ndarray | None = None,
+                 scale: float = 1.0) -> np.ndarray:
+        """CSR data array (nnz,) of scale * Σ blocks + diag."""
+        data = np.zeros(self.nnz + 1)
+        if blocks is not None:
+            data += np.bincount(self._emap_full, weights=blocks.reshape(-1),
+                                minlength=self.nnz + 1)
+        if diag is not None:
+            data[:-1][self._dmap] += diag
+        return scale * data[:-1] if scale != 1.0 else data[:-1]
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+
+
+@dataclass
+class Loading:
+    """Point masses and loads active in one step, split by where they act."""
+
+    node_mass: np.ndarray  # (n_nodes,) kg
+    node_force: np.ndarray  # (n_nodes, 3) N, constant (weights of point masses, constant loads)
+    node_timed: list[tuple[TimeFunction, np.ndarray]]  # f(t) * (n_nodes, 3)
+    internal_ptr: np.ndarray  # (n_elem+1,) CSR of loads inside elements
+    internal_s: np.ndarray  # (m,) m, local arc length
+    internal_force: np.ndarray  # (m, 3) N, constant part
+    internal_timed: list[tuple[TimeFunction, np.ndarray]]  # f(t) * (m, 3)
+    mass_elem: np.ndarray  # (p,) int, point masses inside elements
+    mass_s: np.ndarray  # (p,) m
+    mass_value: np.ndarray  # (p,) kg
+    names: tuple[str, ...] = field(default=())
+
+
+def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
+    """Collect the point masses, point loads and distributed loads active in a step."""
+    g = case.gravity
+    nn, ne = mesh.n_nodes, mesh.n_elements
+    node_mass = np.zeros(nn)
+    node_force = np.zeros((nn, 3))
+    node_timed: dict[int, tuple[TimeFunction, np.ndarray]] = {}
+    items: list[tuple[int, float, np.ndarray, TimeFunction | None]] = []
+    m_e, m_s, m_v = [], [], []
+    names = []
+
+    def where(obj):
+        if obj.node is not None:
+            return "node", mesh.node_index(obj.node), 0.0
+        return mesh.locate(obj.cable, obj.s)
+
+    for pm in case.point_masses:
+        if pm.name in removed:
+            continue
+        names.append(pm.name)
+        kind, idx, s = where(pm)
+        weight = np.array([0.0, 0.0, -pm.mass * g])
+        if kind == "node":
+            node_mass[idx] += pm.mass
+            node_force[idx] += weight
+        else:
+            items.append((idx, s, weight, None))
+            m_e.append(idx)
+            m_s.append(s)
+            m_v.append(pm.mass)
+    for ld in case.loads:
+        if ld.name in removed:
+            continue
+        names.append(ld.name)
+        kind, idx, s = where(ld)
+        f = np.asarray(ld.force, float)
+        if kind == "node":
+            if ld.time is None:
+                node_force[idx] += f
+            else:
+                arr = np.zeros((nn, 3))
+                arr[idx] = f
+                node_timed[id(ld)] = (ld.time, arr)
+        else:
+            items.append((idx, s, f, ld.time))
+    sg, wg = mesh.gauss()
+    for dl in case.distributed_loads:
+        ci = mesh.cable_names.index(dl.cable)
+        p = np.asarray(dl.load, float)
+        for e in np.flatnonzero(mesh.cable_of_element == ci):
+            for k in range(int(mesh.gauss_points[e])):
+                items.append((int(e), float(sg[e, k]), wg[e, k] * mesh.L0[e] * p, dl.time))
+    # CSR of internal loads, sorted by element then s
+    items.sort(key=lambda it: (it[0], it[1]))
+    counts = np.bincount([it[0] for it in items], minlength=ne) if items else np.zeros(ne, int)
+    ptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    s_arr = np.array([it[1] for it in items], float)
+    f_const = np.zeros((len(items), 3))
+    timed: dict[int, tuple[TimeFunction, np.ndarray]] = {}
+    for k, (_, _, f, tf) in enumerate(items):
+        if tf is None:
+            f_const[k] = f
+        else:
+            key = id(tf)
+            if key not in timed:
+                timed[key] = (tf, np.zeros((len(items), 3)))
+            timed[key][1][k] = f
+    return Loading(
+        node_mass=node_mass,
+        node_force=node_force,
+        node_timed=list(node_timed.values()),
+        internal_ptr=ptr,
+        internal_s=s_arr,
+        internal_force=f_const,
+        internal_timed=list(timed.values()),
+        mass_elem=np.array(m_e, np.int64),
+        mass_s=np.array(m_s, float),
+        mass_value=np.array(m_v, float),
+        names=tuple(names),
+    )
+
+
+class Model:
+    """What one analysis step sees: mesh, active loading, supports and their motion."""
+
+    def __init__(self, case: Case, mesh: Mesh, removed: set[str], mass_model: str = "consistent"):
+        self.case = case
+        self.mesh = mesh
+        self.loading = build_loading(case, mesh, removed)
+        self.mass_model = mass_model
+        nn = mesh.n_nodes
+        self.n_dof = 3 * nn
+        fixed = np.zeros((nn, 3), bool)
+        for node, axes in case.supports.items():
+            i = mesh.node_index(node)
+            for ax in axes:
+                fixed[i, AXES.index(ax)] = True
+        self.fixed_mask = fixed  # (n_nodes, 3)
+        self.fixed = np.flatnonzero(fixed.ravel())
+        self.free = np.flatnonzero(~fixed.ravel())
+        # support motion: (dof, TimeFunction) for prescribed displacements
+        self.motions: list[tuple[int, TimeFunction]] = []
+        for sm in case.support_motions:
+            i = mesh.node_index(sm.node)
+            for a, ax in enumerate(AXES):
+                tf = getattr(sm, ax)
+                if tf is not None:
+                    self.motions.append((3 * i + a, tf))
+        ld = self.loading
+        self.elements = Elements(mesh.L0, mesh.EA, mesh.w,
+                                 PointLoads(ld.internal_ptr, ld.internal_s,
+                                            ld.internal_force.copy()))
+        self._t_internal: float | None = None if ld.internal_timed else 0.0
+        self.edofs = (3 * mesh.conn[:, :, None] + np.arange(3)).reshape(-1, 6)  # (n_elem, 6)
+        self.pattern = Pattern(self.edofs, self.n_dof)
+        self.gauss_s, self.gauss_w = mesh.gauss()
+        self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
+                                + ld.mass_value.sum())
+
+    # -------------------------------------------------------------------------------- loads
+    def set_time(self, t: float) -> None:
+        """Update loads inside elements that vary with time (no-op when none do)."""
+        if self._t_internal == t or not self.loading.internal_timed:
+            return
+        f = self.loading.internal_force.copy()
+        for tf, arr in self.loading.internal_timed:
+            f += tf(t) * arr
+        self.elements.set_load_forces(f)
+        self._t_internal = t
+
+    def nodal_load(self, t: float) -> np.ndarray:
+        """External forces applied at nodes, (n_dof,) N."""
+        p = self.loading.node_force.copy()
+        for tf, arr in self.loading.node_timed:
+            p += tf(t) * arr
+        return p.ravel()
+
+    def support_values(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Prescribed displacement, velocity and acceleration of the fixed dofs, (n_fixed,)."""
+        u = np.zeros(self.n_dof)
+        v = np.zeros(self.n_dof)
+        a = np.zeros(self.n_dof)
+        for dof, tf in self.motions:
+            u[dof], v[dof], a[dof] = tf.evaluate(t)
+        return u[self.fixed], v[self.fixed], a[self.fixed]
+
+    def support_positions(self, t: float) -> np.ndarray:
+        """Positions of the fixed dofs at time t: case position + motion, (n_fixed,)."""
+        return self.mesh.X0.ravel()[self.fixed] + self.support_values(t)[0]
+
+    @property
+    def has_internal_loads(self) -> bool:
+        return self.loading.internal_s.size > 0
+
+    @property
+    def has_timed_loads(self) -> bool:
+        return bool(self.loading.node_timed or self.loading.internal_timed)
+
+    # -------------------------------------------------------------------------- element state
+    def chords(self, X: np.ndarray) -> np.ndarray:
+        """(n_elem, 3) chords x_j - x_i from node positions X (n_nodes, 3)."""
+        return X[self.mesh.conn[:, 1]] - X[self.mesh.conn[:, 0]]
+
+    def element_state(self, X: np.ndarray, h0: np.ndarray | None = None) -> ElementState:
+        return self.elements.solve(self.chords(X), h0)
+
+    def internal_force(self, state: ElementState) -> np.ndarray:
+        """Σ_e r_e: forces the nodes supply to hold the elements, (n_dof,) N (§4)."""
+        r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
+        return np.bincount(self.edofs.ravel(), weights=r.reshape(-1),
+                           minlength=self.n_dof)
+
+    def stiffness_data(self, state: ElementState) -> np.ndarray:
+        """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``)."""
+        return self.pattern.assemble(state.stiffness6)
+
+    def stiffness(self, state: ElementState) -> sp.csr_matrix:
+        return self.pattern.matrix(self.stiffness_data(state))
+
+    # ------------------------------------------------------------------------------- mass
+    def element_mass(self, state: ElementState, per_length: np.ndarray | None = None,
+                     with_points: bool = True) -> np.ndarray:
+        """Consistent element matrices Σ_g q L0 w_g NᵀN (+ point masses), (n_elem, 6, 6) (§7).
+
+        ``per_length`` is the mass per unstrained length (default) or, for material damping,
+        the damping coefficient per length.
+        """
+        mesh = self.mesh
+        q = mesh.m if per_length is None else per_length
+        nmat = self.elements.interpolation(state, self.gauss_s)  # (n_elem, g, 3, 6)
+        wq = (q * mesh.L0)[:, None] * self.gauss_w  # (n_elem, g)
+        me = np.einsum("eg,egki,egkj->eij", wq, nmat, nmat)
+        ld = self.loading
+        if with_points and ld.mass_value.size:
+            e = ld.mass_elem
+            s = np.zeros((mesh.n_elements, 1))
+            # one point at a time keeps shapes regular (point masses are few)
+            for k in range(e.size):
+                s[:] = 0.0
+                s[e[k], 0] = ld.mass_s[k]
+                nk = self.elements.interpolation(state, s)[e[k], 0]  # (3, 6)
+                me[e[k]] += ld.mass_value[k] * nk.T @ nk
+        return me
+
+    def lumped_mass_diag(self) -> np.ndarray:
+        """Lumped masses on the dofs: half of each element's mass at each end, (n_dof,) kg."""
+        mesh = self.mesh
+        node = np.zeros(mesh.n_nodes)
+        half = 0.5 * mesh.m * mesh.L0
+        np.add.at(node, mesh.conn[:, 0], half)
+        np.add.at(node, mesh.conn[:, 1], half)
+        ld = self.loading
+        if ld.mass_value.size:
+            frac = ld.mass_s / mesh.L0[ld.mass_elem]
+            np.add.at(node, mesh.conn[ld.mass_elem, 0], (1 - frac) * ld.mass_value)
+            np.add.at(node, mesh.conn[ld.mass_elem, 1], frac * ld.mass_value)
+        return np.repeat(node + ld.node_mass, 3)
+
+    def mass_data(self, state: ElementState) -> np.ndarray:
+        """CSR data of the mass matrix M(q) on the full dof set."""
+        node_diag = np.repeat(self.loading.node_mass, 3)
+        if self.mass_model == "lumped":
+            return self.pattern.assemble(None, self.lumped_mass_diag())
+        return self.pattern.assemble(self.element_mass(state), node_diag)
+
+    def mass(self, state: ElementState) -> sp.csr_matrix:
+        return self.pattern.matrix(self.mass_data(state))
+
+    def material_damping_data(self, state: ElementState) -> np.ndarray:
+        """CSR data of C = Σ_g c L0 w_g NᵀN (material damping, §7)."""
+        if self.mass_model == "lumped":
+            mesh = self.mesh
+            node = np.zeros(mesh.n_nodes)
+            half = 0.5 * mesh.c * mesh.L0
+            np.add.at(node, mesh.conn[:, 0], half)
+            np.add.at(node, mesh.conn[:, 1], half)
+            return self.pattern.assemble(None, np.repeat(node, 3))
+        return self.pattern.assemble(self.element_mass(state, self.mesh.c, with_points=False))
+
+    # ------------------------------------------------------------------------- reporting
+    def reactions(self, state: ElementState, t: float) -> np.ndarray:
+        """Force the supports exert on the cable, (n_nodes, 3) N; NaN on free axes.
+
+        Node equilibrium: support force + external load = Σ resisting forces. Inertia of point
+        masses sitting on a support node is not included (the support carries it directly).
+        """
+        r = self.internal_force(state) - self.nodal_load(t)
+        out = np.full(self.n_dof, np.nan)
+        out[self.fixed] = r[self.fixed]
+        return out.reshape(-1, 3)
+
+    def tensions(self, state: ElementState) -> np.ndarray:
+        """Tension at ends i and j of every element, (n_elem, 2) N."""
+        return self.elements.end_tensions(state.h)

@@ -1,0 +1,112 @@
+"""Static equilibrium: Newton on the free dofs with the assembled sparse tangent stiffness.
+
+R(X) = Σ_e r_e(X) - P = 0 on the free dofs (formulation.md §4). Each Newton step solves
+K_t dX = -R with the sparse tangent stiffness, and is damped by backtracking on |R| (the Newton
+direction always descends |R|² since K_t is non-singular). Loads beyond the self-weight (point
+loads, point masses, distributed loads) are applied in load steps; a load step that fails is
+halved, so that hard starts (a large point load on a slack cable) still converge.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from .assembly import Model
+from .element import NOT_CONVERGED, ElementState
+from .errors import ConvergenceError
+
+
+@dataclass
+class StaticSolution:
+    X: np.ndarray  # (n_nodes, 3) m
+    state: ElementState
+    iterations: int  # Newton iterations, all load steps
+    residual_norm: float  # N, max |R| on free dofs at the end
+    load_steps: int  # load increments used
+
+
+def _residual(model: Model, state: ElementState, p: np.ndarray) -> np.ndarray:
+    return (model.internal_force(state) - p)[model.free]
+
+
+def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: float = 0.0,
+                 load_steps: int = 1, rtol: float = 1e-11, max_iter: int = 200) -> StaticSolution:
+    """Equilibrium of ``model`` at time ``t`` starting from node positions ``X`` (n_nodes, 3)."""
+    X = np.array(X, float, copy=True)
+    X.reshape(-1)[model.fixed] = model.support_positions(t)
+    model.set_time(t)
+    p_full = model.nodal_load(t)
+    f_full = model.elements.loads.f.copy()
+    state = model.element_state(X, h0)
+    if (state.status == NOT_CONVERGED).any():
+        state = model.element_state(X)
+    free = model.free
+    weight = float((model.mesh.w * model.mesh.L0).sum())
+    fscale = max(weight + np.abs(p_full).sum() + np.abs(f_full).sum(), 1e-300)
+    total_iter = 0
+    lam = 0.0
+    dlam = 1.0 / max(int(load_steps), 1)
+    n_inc = 0
+    if not model.has_internal_loads and not np.any(p_full):
+        dlam = 1.0
+    while lam < 1.0:
+        target = min(1.0, lam + dlam)
+        model.elements.set_load_forces(target * f_full)
+        p = target * p_full
+        ok, X_new, state_new, its, rnorm = _newton(model, X, state, p, fscale, rtol, max_iter)
+        total_iter += its
+        if ok:
+            X, state, lam = X_new, state_new, target
+            n_inc += 1
+            dlam = min(2.0 * dlam, 1.0 - lam) if lam < 1.0 else dlam
+            continue
+        dlam *= 0.5
+        model.elements.set_load_forces(lam * f_full)
+        if dlam < 1e-6:
+            model.elements.set_load_forces(f_full)
+            raise ConvergenceError(
+                f"static equilibrium not found: load factor stuck at {lam:.6g} "
+                f"(|R| = {rnorm:.3g} N after {total_iter} Newton iterations)")
+    r = _residual(model, state, p_full)
+    return StaticSolution(X, state, total_iter, float(np.abs(r).max(initial=0.0)), n_inc)
+
+
+def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
+    """Damped Newton at a fixed load. Returns (ok, X, state, iterations, |R|)."""
+    free = model.free
+    r = _residual(model, state, p)
+    rn = np.linalg.norm(r)
+    if free.size == 0:
+        return True, X, state, 0, rn
+    for it in range(1, max_iter + 1):
+        tscale = max(fscale, float(np.abs(state.h).max(initial=0.0)))
+        if rn <= rtol * tscale:
+            return True, X, state, it - 1, rn
+        k = model.stiffness(state)[free][:, free].tocsc()
+        try:
+            dx = spla.spsolve(k, -r)
+        except RuntimeError:
+            return False, X, state, it, rn
+        if not np.all(np.isfinite(dx)):
+            return False, X, state, it, rn
+        alpha = 1.0
+        for _ in range(40):
+            Xt = X.copy()
+            Xt.reshape(-1)[free] += alpha * dx
+            st = model.element_state(Xt, state.h)
+            if not (st.status == NOT_CONVERGED).any():
+                rt = _residual(model, st, p)
+                rtn = np.linalg.norm(rt)
+                if np.isfinite(rtn) and rtn <= (1.0 - 1e-4 * alpha) * rn:
+                    break
+            alpha *= 0.5
+        else:
+            # no decrease: converged to round-off, or stuck
+            return rn <= 1e3 * rtol * tscale, X, state, it, rn
+        X, state, r, rn = Xt, st, rt, rtn
+        if alpha == 1.0 and np.abs(dx).max() <= 1e-14 * max(1.0, np.abs(X).max()):
+            return True, X, state, it, rn
+    return rn <= rtol * fscale, X, state, max_iter, rn
