@@ -43,7 +43,6 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
     state = model.element_state(X, h0)
     if (state.status == NOT_CONVERGED).any():
         state = model.element_state(X)
-    free = model.free
     weight = float((model.mesh.w * model.mesh.L0).sum())
     fscale = max(weight + np.abs(p_full).sum() + np.abs(f_full).sum(), 1e-300)
     total_iter = 0
