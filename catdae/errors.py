@@ -17,7 +17,8 @@ class CaseError(CatdaeError):
         self.path = path
         self.problems = list(problems)
         where = path or "<case>"
-        lines = [f"{where}: {field}: {msg}" if field else f"{where}: {msg}" for field, msg in problems]
+        lines = [f"{where}: {field}: {msg}" if field else f"{where}: {msg}"
+                 for field, msg in problems]
         super().__init__("\n".join(lines) if lines else f"{where}: invalid case")
 
 

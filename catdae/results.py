@@ -1,0 +1,151 @@
+"""Labelled results: the only module that builds xarray objects (case-format.md, "Results").
+
+Every variable carries ``units`` and ``long_name``; attributes are str or numbers only (netCDF
+refuses dict, None and bool). Files are written to a temporary name beside the target and moved
+into place, so an existing file is only ever replaced by a complete one.
+"""
+
+from __future__ import annotations
+
+import os
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from .mesh import AXES, Mesh
+
+
+def _var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
+    return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name, **attrs})
+
+
+def _coords(mesh: Mesh, with_elements: bool = True) -> dict:
+    coords = {
+        "node": xr.Variable("node", np.array(mesh.node_names, dtype=object),
+                            {"long_name": "node name"}),
+        "axis": xr.Variable("axis", np.array(AXES, dtype=object),
+                            {"long_name": "global axis (z up)"}),
+    }
+    if with_elements:
+        coords["element"] = xr.Variable("element", np.array(mesh.element_names, dtype=object),
+                                        {"long_name": "element name"})
+        coords["end"] = xr.Variable("end", np.array(["i", "j"], dtype=object),
+                                    {"long_name": "element end"})
+    return coords
+
+
+def clean_attrs(attrs: dict) -> dict:
+    """Attributes netCDF can store: bool -> int, None dropped, numpy scalars -> python."""
+    out = {}
+    for k, v in attrs.items():
+        if v is None:
+            continue
+        if isinstance(v, bool | np.bool_):
+            v = int(v)
+        elif isinstance(v, np.generic):
+            v = v.item()
+        out[k] = v
+    return out
+
+
+def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.ndarray,
+                   attrs: dict) -> xr.Dataset:
+    """One static step: positions (n_nodes, 3), tensions (n_elem, 2), reactions (n_nodes, 3)."""
+    d = ("node", "axis")
+    ds = xr.Dataset(
+        {
+            "position": _var(d, X, "m", "node position"),
+            "displacement": _var(d, X - mesh.X0, "m", "displacement from reference_position"),
+            "reference_position": _var(d, mesh.X0, "m",
+                                       "meshed catenary under self-weight (reference)"),
+            "tension": _var(("element", "end"), tension, "N", "cable tension at element end"),
+            "reaction": _var(d, reaction, "N",
+                             "force the support exerts on the cable (NaN where free)"),
+        },
+        coords=_coords(mesh),
+        attrs=clean_attrs({"kind": "static", **attrs}),
+    )
+    return ds
+
+
+def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, symmetry,
+                  attrs: dict) -> xr.Dataset:
+    """Modal step: frequencies (n_modes,) Hz and shapes (n_modes, n_nodes, 3), unit maximum."""
+    n = len(frequency)
+    coords = _coords(mesh, with_elements=False)
+    coords["mode"] = xr.Variable("mode", np.arange(1, n + 1), {"long_name": "mode number"})
+    ds = xr.Dataset(
+        {
+            "frequency": _var("mode", frequency, "Hz", "natural frequency"),
+            "shape": _var(("mode", "node", "axis"), shape, "1",
+                          "mode shape (largest nodal displacement component = 1)"),
+            "plane": _var("mode", np.array(plane, dtype=object), "1",
+                          "in-plane or out-of-plane (single-span cables; else unclassified)"),
+            "symmetry": _var("mode", np.array(symmetry, dtype=object), "1",
+                             "symmetric or antisymmetric about midspan (single-span cables)"),
+        },
+        coords=coords,
+        attrs=clean_attrs({"kind": "modal", **attrs}),
+    )
+    return ds
+
+
+def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, energy,
+                      attrs: dict) -> xr.Dataset:
+    """Transient step: histories with time first."""
+    d = ("time", "node", "axis")
+    coords = _coords(mesh)
+    coords["time"] = xr.Variable("time", np.asarray(time), {"units": "s", "long_name": "time"})
+    X = np.asarray(X).reshape(len(time), -1, 3)
+    data = {
+        "position": _var(d, X, "m", "node position"),
+        "displacement": _var(d, X - mesh.X0[None], "m", "displacement from reference_position"),
+        "velocity": _var(d, np.asarray(V).reshape(X.shape), "m/s", "node velocity"),
+        "acceleration": _var(d, np.asarray(A).reshape(X.shape), "m/s2", "node acceleration"),
+        "reference_position": _var(("node", "axis"), mesh.X0, "m",
+                                   "meshed catenary under self-weight (reference)"),
+        "tension": _var(("time", "element", "end"), tension, "N",
+                        "cable tension at element end"),
+        "reaction": _var(d, reaction, "N",
+                         "force the support exerts on the cable (NaN where free)"),
+    }
+    for key, (values, long_name) in energy.items():
+        data[key] = _var("time", values, "J", long_name)
+    return xr.Dataset(data, coords=coords, attrs=clean_attrs({"kind": "transient", **attrs}))
+
+
+def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") -> xr.DataTree:
+    """Root with provenance and one group per step, in step order."""
+    root = xr.Dataset(attrs=clean_attrs({
+        "title": case.title,
+        "source": case.source,
+        "case_toml": case.text,
+        "case_name": case.name,
+        "catdae_version": __version__,
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "status": status,
+        "Conventions": "CF-1.10",
+    }))
+    return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
+
+
+def write_tree(tree: xr.DataTree, path: str | os.PathLike) -> Path:
+    """Write netCDF-4 with groups atomically: a temporary file moved over the target."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        tree.to_netcdf(tmp, engine="netcdf4")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def read_tree(path: str | os.PathLike) -> xr.DataTree:
+    """Open a results file fully into memory (the file is closed afterwards)."""
+    with xr.open_datatree(path, engine="netcdf4") as tree:
+        return tree.load()

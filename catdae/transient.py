@@ -1,0 +1,447 @@
+"""Nonlinear transient dynamics with SUNDIALS IDA (formulation.md §8).
+
+The only module that imports sksundae. Unknowns y = [q, v] of the free dofs, interleaved per dof
+(q_k, v_k side by side) after a reverse Cuthill-McKee ordering of the free dofs, so that the
+iteration matrix of a single cable is narrowly banded. Residual:
+
+    r_q = q' - v
+    r_v = M(q) v' + C(q) v + F(q) - P(t)    (+ the support coupling terms M_fp a_p + C_fp v_p)
+
+M(q), C(q) and F(q) come from the current configuration at every residual evaluation: the
+element tensions are re-solved (warm-started) for the current chords, then the consistent mass
+of the interpolation functions is assembled. The iteration matrix is analytic:
+
+    J = [[c_j I, -I], [K_t(q), c_j M(q) + C(q)]]
+
+(the derivatives of M(q) v' and C(q) v with respect to q are left out; IDA only needs a good
+iteration matrix, see ../shared/ida-notes.md). A trial state where an element cannot be solved
+is answered with NaN in the residual, which IDA treats as recoverable: it retries with a smaller
+step. Output is interpolated by IDA at the output times without shortening its own steps.
+
+Energy: the semi-discrete equations with a configuration-dependent M(q) and without the
+dM/dq v terms are not derived from a Lagrangian, so the total energy (kinetic + strain +
+gravity) of an undamped motion is not an exact invariant of them; it is recorded at every output
+(``energy_total``) so that its drift can be measured. In free vibration the drift is bounded by
+the integration error and shrinks as the tolerance tightens (tests/test_transient.py).
+"""
+
+from __future__ import annotations
+
+import sys
+import time as _time
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+import xarray as xr
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+from sksundae.ida import IDA
+
+from . import results
+from .assembly import Model
+from .element import NOT_CONVERGED, ElementState
+from .errors import SolverError
+
+INCREMENT_SECONDS = 20.0  # wall time between incremental writes of a long run
+
+
+class TransientProblem:
+    """Residual and iteration matrix of one transient step, with evaluation counters."""
+
+    def __init__(self, model: Model, step, X0: np.ndarray, h0: np.ndarray | None):
+        self.model = model
+        self.step = step
+        self.n_dof = model.n_dof
+        free = model.free
+        # --- ordering: reverse Cuthill-McKee on the free-free stiffness graph
+        pat = model.pattern
+        full = sp.csr_matrix((np.ones(pat.nnz), pat.indices, pat.indptr),
+                             shape=(self.n_dof, self.n_dof))
+        ff = full[free][:, free]
+        perm = np.asarray(reverse_cuthill_mckee(ff.tocsr(), symmetric_mode=True), np.int64)
+        self.fidx = free[perm]  # full dof of unknown k
+        self.n = self.fidx.size
+        pos = np.full(self.n_dof, -1, np.int64)
+        pos[self.fidx] = np.arange(self.n)
+        rows = np.repeat(np.arange(self.n_dof), np.diff(pat.indptr))
+        cols = pat.indices.astype(np.int64)
+        keep = (pos[rows] >= 0) & (pos[cols] >= 0)
+        self.ff_sel = np.flatnonzero(keep)  # entries of the full CSR data in the ff block
+        self.ff_a = pos[rows[keep]]
+        self.ff_b = pos[cols[keep]]
+        self.bandwidth = int(np.abs(self.ff_a - self.ff_b).max(initial=0))
+        # --- sparse pattern of J (interleaved): rows 2a (q) and 2a+1 (v)
+        a, b = self.ff_a, self.ff_b
+        n = self.n
+        jr = np.concatenate([2 * np.arange(n), 2 * np.arange(n), 2 * a + 1, 2 * a + 1])
+        jc = np.concatenate([2 * np.arange(n), 2 * np.arange(n) + 1, 2 * b, 2 * b + 1])
+        keys = jc * (2 * n) + jr  # column-major for CSC
+        ukeys, inv = np.unique(keys, return_inverse=True)
+        self.j_nnz = ukeys.size
+        jcsc_rows = (ukeys % (2 * n)).astype(np.int32)
+        jcsc_cols = ukeys // (2 * n)
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(jcsc_cols, minlength=2 * n))])
+        self.j_pattern = sp.csc_matrix((np.ones(self.j_nnz), jcsc_rows, indptr),
+                                       shape=(2 * n, 2 * n))
+        m = a.size
+        self.jmap_qq = inv[:n]
+        self.jmap_qv = inv[n:2 * n]
+        self.jmap_vq = inv[2 * n:2 * n + m]
+        self.jmap_vv = inv[2 * n + m:]
+        # --- damping
+        self.damping = step.damping
+        self.alpha = self.beta = 0.0
+        if self.damping is not None and self.damping.kind == "rayleigh":
+            self.alpha, self.beta = self.damping.coefficients()
+        # --- work arrays and state
+        self.X = np.array(X0, float).reshape(-1).copy()
+        self.h = None if h0 is None else np.array(h0, float, copy=True)
+        self._support_t = None
+        self.n_res = 0
+        self.n_jac = 0
+        self.n_rejected = 0
+
+    # ------------------------------------------------------------------ pieces
+    def _supports(self, t: float):
+        if self._support_t != t:
+            m = self.model
+            u, v, a = m.support_values(t)
+            self._sup = (m.mesh.X0.reshape(-1)[m.fixed] + u, v, a)
+            self._support_t = t
+        return self._sup
+
+    def configuration(self, t: float, q: np.ndarray) -> ElementState | None:
+        """Element state for free positions q at time t, or None if an element fails."""
+        m = self.model
+        xp, _, _ = self._supports(t)
+        self.X[self.fidx] = q
+        self.X[m.fixed] = xp
+        m.set_time(t)
+        state = m.elements.solve(m.chords(self.X.reshape(-1, 3)), self.h)
+        if (state.status == NOT_CONVERGED).any():
+            return None
+        if not np.all(np.isfinite(state.h)):
+            return None
+        self.h = state.h
+        return state
+
+    def matrices(self, state: ElementState, with_k: bool):
+        """CSR data of M, C (or None) and K_t (if needed) on the full dof set."""
+        m = self.model
+        mdata = m.mass_data(state)
+        kdata = m.stiffness_data(state) if (with_k or self.beta) else None
+        cdata = None
+        if self.damping is not None:
+            if self.damping.kind == "material":
+                cdata = m.material_damping_data(state)
+            else:
+                cdata = self.alpha * mdata
+                if self.beta:
+                    cdata = cdata + self.beta * kdata
+        return mdata, cdata, kdata
+
+    def full_vectors(self, t: float, v: np.ndarray, vd: np.ndarray):
+        m = self.model
+        _, vp, ap = self._supports(t)
+        V = np.zeros(self.n_dof)
+        A = np.zeros(self.n_dof)
+        V[self.fidx] = v
+        A[self.fidx] = vd
+        V[m.fixed] = vp
+        A[m.fixed] = ap
+        return V, A
+
+    def dynamic_force(self, t, state, V, A):
+        """M A + C V + F - P on the full dof set, (n_dof,) N."""
+        m = self.model
+        mdata, cdata, _ = self.matrices(state, with_k=False)
+        out = m.pattern.matrix(mdata) @ A + m.internal_force(state) - m.nodal_load(t)
+        if cdata is not None:
+            out += m.pattern.matrix(cdata) @ V
+        return out
+
+    # ------------------------------------------------------------------ IDA callbacks
+    def resfn(self, t, y, yp, res):
+        self.n_res += 1
+        try:
+            q = y[0::2]
+            state = self.configuration(t, q)
+            if state is None:
+                self.n_rejected += 1
+                res[:] = np.nan
+                return
+            V, A = self.full_vectors(t, y[1::2], yp[1::2])
+            f = self.dynamic_force(t, state, V, A)
+            res[0::2] = yp[0::2] - y[1::2]
+            res[1::2] = f[self.fidx]
+        except (FloatingPointError, ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+            self.n_rejected += 1
+            res[:] = np.nan
+
+    def _jac_parts(self, t, y, cj):
+        state = self.configuration(t, y[0::2])
+        if state is None:
+            return None
+        mdata, cdata, kdata = self.matrices(state, with_k=True)
+        sel = self.ff_sel
+        vv = cj * mdata[sel]
+        if cdata is not None:
+            vv = vv + cdata[sel]
+        return kdata[sel], vv
+
+    def jac_dense(self, t, y, yp, res, cj, JJ):
+        """Iteration matrix into the full (2n, 2n) array (dense and band solvers)."""
+        self.n_jac += 1
+        parts = self._jac_parts(t, y, cj)
+        JJ[:, :] = 0.0
+        idx = np.arange(self.n)
+        JJ[2 * idx, 2 * idx] = cj
+        JJ[2 * idx, 2 * idx + 1] = -1.0
+        if parts is None:  # keep a usable matrix; the residual will reject the state
+            JJ[2 * idx + 1, 2 * idx + 1] = cj
+            return
+        kv, vv = parts
+        JJ[2 * self.ff_a + 1, 2 * self.ff_b] = kv
+        JJ[2 * self.ff_a + 1, 2 * self.ff_b + 1] = vv
+
+    def jac_sparse(self, t, y, yp, res, cj, JJ):
+        """Iteration matrix as the CSC data array of ``j_pattern`` (sparse solver)."""
+        self.n_jac += 1
+        parts = self._jac_parts(t, y, cj)
+        data = np.zeros(self.j_nnz)
+        data[self.jmap_qq] = cj
+        data[self.jmap_qv] = -1.0
+        if parts is None:
+            data[self.jmap_vv[self.ff_a == self.ff_b]] = cj
+        else:
+            kv, vv = parts
+            np.add.at(data, self.jmap_vq, kv)
+            np.add.at(data, self.jmap_vv, vv)
+        JJ[:] = data
+
+    # ------------------------------------------------------------------ start and output
+    def initial(self, t0: float, X: np.ndarray, V: np.ndarray):
+        """Consistent y0, yp0: v'(0) = M⁻¹ (P - C v - F - coupling) on the free dofs."""
+        q0 = X.reshape(-1)[self.fidx]
+        v0 = V.reshape(-1)[self.fidx]
+        state = self.configuration(t0, q0)
+        if state is None:
+            raise SolverError("transient start: an element cannot be solved in the initial "
+                              "configuration", termination="initial state")
+        V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
+        f = self.dynamic_force(t0, state, V_full, A_full)  # M_fp a_p + C v + F - P
+        mdata = self.model.mass_data(state)
+        mff = sp.csr_matrix((mdata[self.ff_sel], (self.ff_a, self.ff_b)), shape=(self.n, self.n))
+        a0 = spla.spsolve(mff.tocsc(), -f[self.fidx])
+        y0 = np.empty(2 * self.n)
+        yp0 = np.empty(2 * self.n)
+        y0[0::2], y0[1::2] = q0, v0
+        yp0[0::2], yp0[1::2] = v0, a0
+        return y0, yp0
+
+    def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
+        """Positions, velocities, accelerations, tensions, reactions and energies at t."""
+        m = self.model
+        state = self.configuration(t, y[0::2])
+        if state is None:
+            raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
+                              termination="element failure")
+        V, A = self.full_vectors(t, y[1::2], yp[1::2])
+        X = self.X.copy()
+        f = self.dynamic_force(t, state, V, A)
+        reaction = np.full(self.n_dof, np.nan)
+        reaction[m.fixed] = f[m.fixed]
+        mdata = m.mass_data(state)
+        kinetic = 0.5 * V @ (m.pattern.matrix(mdata) @ V)
+        strain, gravity = _potential(m, X.reshape(-1, 3), state, t)
+        return (X, V, A, m.tensions(state), reaction.reshape(-1, 3),
+                (kinetic, strain, gravity))
+
+
+def _potential(model: Model, X: np.ndarray, state: ElementState, t: float):
+    """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J."""
+    mesh = model.mesh
+    el = model.elements
+    xi, wi = np.polynomial.legendre.leggauss(8)
+    s = 0.5 * (xi + 1.0)[None, :] * mesh.L0[:, None]  # (n_elem, 8)
+    wq = 0.5 * wi[None, :] * mesh.L0[:, None]
+    tens = el.tension(state.h, s)  # (n_elem, 8)
+    strain = float(np.sum(wq * tens**2 / (2.0 * mesh.EA[:, None])))
+    z = X[mesh.conn[:, 0], 2][:, None] + el.position(state.h, s)[..., 2]
+    gravity = float(np.sum(wq * mesh.w[:, None] * z))
+    # loads inside elements (point-mass weights, constant loads) and at nodes
+    ld = model.loading
+    if ld.internal_s.size:
+        counts = np.diff(ld.internal_ptr)
+        e_of = np.repeat(np.arange(mesh.n_elements), counts)
+        sq = np.zeros((mesh.n_elements, max(int(counts.max()), 1)))
+        slot = np.arange(ld.internal_s.size) - ld.internal_ptr[e_of]
+        sq[e_of, slot] = ld.internal_s
+        xk = X[mesh.conn[:, 0]][:, None, :] + el.position(state.h, sq)
+        gravity -= float(np.sum(el.loads.f * xk[e_of, slot]))
+    gravity -= float(model.nodal_load(t) @ X.reshape(-1))
+    return strain, gravity
+
+
+def choose_solver(problem: TransientProblem, requested: str) -> str:
+    """'band' when the band is narrow, 'sparse' for networks with a wide band, 'dense' tiny."""
+    if requested != "auto":
+        return requested
+    n2 = 2 * problem.n
+    band = 4 * problem.bandwidth + 3
+    if n2 <= 24:
+        return "dense"
+    if band <= max(16, n2 // 8):
+        return "band"
+    return "sparse"
+
+
+def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
+    """Integrate one transient step from ``state`` (positions, velocities, tensions)."""
+    wall0 = _time.perf_counter()
+    prob = TransientProblem(model, step, state.X, state.h)
+    t0 = 0.0
+    t_end = float(step.duration)
+    dt_out = float(step.output_interval)
+    n_out = int(np.floor(t_end / dt_out + 1e-9)) + 1
+    times = t0 + dt_out * np.arange(n_out)
+    if times[-1] < t_end - 1e-12 * t_end:
+        times = np.append(times, t_end)
+    y0, yp0 = prob.initial(t0, state.X, state.V)
+    linsolver = choose_solver(prob, step.linear_solver)
+    omega = _reference_frequency(prob, y0)
+    atol = np.empty(2 * prob.n)
+    atol[0::2] = step.atol
+    atol[1::2] = step.atol * omega
+    options = dict(rtol=step.rtol, atol=atol, max_order=int(step.max_order),
+                   max_num_steps=100000, linsolver=linsolver)
+    if linsolver == "band":
+        bw = prob.bandwidth
+        options.update(lband=2 * bw + 1, uband=max(2 * bw, 1), jacfn=prob.jac_dense)
+    elif linsolver == "sparse":
+        options.update(sparsity=prob.j_pattern, jacfn=prob.jac_sparse)
+    else:
+        options.update(jacfn=prob.jac_dense)
+    solver = IDA(prob.resfn, **options)
+    solver.init_step(t0, y0, yp0)
+
+    nn = model.mesh.n_nodes
+    ne = model.mesh.n_elements
+    out_X = np.full((times.size, nn, 3), np.nan)
+    out_V = np.full_like(out_X, np.nan)
+    out_A = np.full_like(out_X, np.nan)
+    out_T = np.full((times.size, ne, 2), np.nan)
+    out_R = np.full_like(out_X, np.nan)
+    out_E = np.full((times.size, 3), np.nan)
+
+    def record(k, t, y, yp):
+        X, V, A, T, R, E = prob.observe(t, y, yp)
+        out_X[k], out_V[k], out_A[k] = X.reshape(-1, 3), V.reshape(-1, 3), A.reshape(-1, 3)
+        out_T[k], out_R[k], out_E[k] = T, R, E
+
+    n_steps = 0
+    status = "completed"
+    k_done = 0
+    bar = _progress_bar(progress, t_end, step.name)
+    last_write = _time.perf_counter()
+
+    def dataset(n_valid):
+        sl = slice(0, n_valid)
+        energy = {
+            "energy_kinetic": (out_E[sl, 0], "kinetic energy ½ vᵀ M v"),
+            "energy_strain": (out_E[sl, 1], "elastic strain energy ∫ T²/(2EA) ds"),
+            "energy_potential": (out_E[sl, 2], "potential of gravity and constant loads"),
+            "energy_total": (out_E[sl].sum(axis=1), "kinetic + strain + potential"),
+        }
+        attrs = {
+            "n_steps": n_steps, "n_residual_evaluations": prob.n_res,
+            "n_jacobian_evaluations": prob.n_jac,
+            "n_rejected_states": prob.n_rejected,
+            "wall_time": _time.perf_counter() - wall0, "rtol": step.rtol, "atol": step.atol,
+            "atol_velocity": step.atol * omega, "status": status, "linear_solver": linsolver,
+            "bandwidth": prob.bandwidth, "max_order": int(step.max_order),
+            "mass_model": model.mass_model,
+            "damping": "none" if step.damping is None else step.damping.kind,
+            "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
+            "n_outputs": n_valid,
+        }
+        return results.transient_dataset(model.mesh, times[sl], out_X[sl], out_V[sl],
+                                          out_A[sl], out_T[sl], out_R[sl], energy, attrs)
+
+    try:
+        record(0, t0, y0, yp0)
+        k_done = 1
+        t_int = t0
+        while k_done < times.size:
+            res = solver.step(t_end, method="onestep", tstop=t_end)
+            if not res.success:
+                status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
+                break
+            n_steps += 1
+            t_int = float(np.atleast_1d(res.t)[-1])
+            while k_done < times.size and times[k_done] <= t_int * (1 + 1e-13) + 1e-300:
+                tk = times[k_done]
+                if abs(tk - t_int) <= 1e-13 * max(abs(t_int), 1.0):
+                    yk, ypk = np.atleast_2d(res.y)[-1], np.atleast_2d(res.yp)[-1]
+                else:
+                    ri = solver.step(tk, method="normal")
+                    yk, ypk = np.atleast_2d(ri.y)[-1], np.atleast_2d(ri.yp)[-1]
+                record(k_done, tk, yk, ypk)
+                k_done += 1
+            if bar is not None:
+                bar.update(t_int - bar.n)
+            if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
+                writer.write_increment(step.name, dataset(k_done))
+                last_write = _time.perf_counter()
+    except KeyboardInterrupt:
+        status = f"interrupted at t = {times[k_done - 1]:.6g} s"
+    except SolverError as exc:
+        status = str(exc)
+    finally:
+        if bar is not None:
+            bar.close()
+    ds = dataset(k_done)
+    if status != "completed":
+        raise SolverError(f"transient step '{step.name}': {status}", termination=status,
+                          partial=ds)
+    # hand the final state to the next step
+    state.X = out_X[-1].copy()
+    state.V = out_V[-1].copy()
+    state.h = prob.h
+    return ds
+
+
+def _reference_frequency(prob: TransientProblem, y0: np.ndarray) -> float:
+    """ω of the lowest mode about the start (rad/s): scales the velocity tolerance."""
+    m = prob.model
+    state = prob.configuration(0.0, y0[0::2])
+    try:
+        mdata = m.mass_data(state)
+        kdata = m.stiffness_data(state)
+        kff = sp.csr_matrix((kdata[prob.ff_sel], (prob.ff_a, prob.ff_b)), shape=(prob.n,) * 2)
+        mff = sp.csr_matrix((mdata[prob.ff_sel], (prob.ff_a, prob.ff_b)), shape=(prob.n,) * 2)
+        if prob.n <= 400:
+            import scipy.linalg as sla
+
+            lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,
+                           subset_by_index=[0, 0])[0]
+        else:
+            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), sigma=0.0, which="LM",
+                             return_eigenvectors=False)[0]
+        if np.isfinite(lam) and lam > 0:
+            return float(np.sqrt(lam))
+    except (ValueError, RuntimeError, np.linalg.LinAlgError, spla.ArpackError):
+        pass
+    return 2.0 * np.pi
+
+
+def _progress_bar(progress, total, name):
+    if progress is None:
+        progress = sys.stderr.isatty()
+    if not progress:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=name, unit="s", leave=False,
+                bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.3f}/{total:.3f} s "
+                           "[{elapsed}<{remaining}]")
