@@ -1,0 +1,189 @@
+"""Time functions of the case file: ``constant``, ``ramp``, ``sine``, ``cosine`` and ``table``.
+
+A time function scales a load or prescribes one axis of a support motion. Every function is a
+frozen dataclass with
+
+- ``evaluate(t) -> (f, df/dt, d2f/dt2)``, vectorised over ``t`` (a scalar gives three floats, an
+  array gives three arrays of its shape), with analytic derivatives: support motions need the
+  velocity and acceleration of the prescribed displacement, not only its value;
+- ``__call__(t)``, the value ``f`` alone.
+
+Absence convention: a load with no ``time`` is constant, factor ``ONE``; an axis of a support with
+no motion does not move, displacement ``ZERO``. ``evaluate_or(func, t, absent=...)`` applies it so
+that callers need not special-case ``None``.
+
+The functions are data: they are built from validated numbers by :mod:`catdae.case`, nothing in a
+case file is ever evaluated as code.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+__all__ = [
+    "ONE",
+    "ZERO",
+    "Constant",
+    "Cosine",
+    "Ramp",
+    "Sine",
+    "Table",
+    "TimeFunction",
+    "evaluate_or",
+]
+
+def _pack(t: np.ndarray, f, df, d2f, scalar: bool) -> tuple:
+    """Broadcast the three results to the shape of ``t``; plain floats for a scalar ``t``."""
+    f, df, d2f = (np.broadcast_to(np.asarray(a, dtype=float), t.shape).copy() for a in (f, df, d2f))
+    if scalar:
+        return float(f), float(df), float(d2f)
+    return f, df, d2f
+
+
+@dataclass(frozen=True)
+class TimeFunction:
+    """Base class: a scalar function of time ``f(t)`` with its first two derivatives."""
+
+    kind: ClassVar[str] = ""
+
+    def evaluate(self, t) -> tuple:
+        """Return ``(f, df/dt, d2f/dt2)`` at time(s) ``t`` in seconds."""
+        t_arr = np.asarray(t, dtype=float)
+        f, df, d2f = self._evaluate(t_arr)
+        return _pack(t_arr, f, df, d2f, scalar=t_arr.ndim == 0)
+
+    def __call__(self, t):
+        """The value ``f(t)``: a float for a scalar ``t``, an array shaped like ``t`` otherwise."""
+        return self.evaluate(t)[0]
+
+    def _evaluate(self, t: np.ndarray):  # pragma: no cover - every subclass overrides it
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Constant(TimeFunction):
+    """``f(t) = value``."""
+
+    value: float
+    kind: ClassVar[str] = "constant"
+
+    def _evaluate(self, t):
+        return self.value, 0.0, 0.0
+
+
+@dataclass(frozen=True)
+class Ramp(TimeFunction):
+    """A ramp from 0 (before ``start``) to 1 (after ``start + duration``).
+
+    With ``smooth = False`` the ramp is linear: its slope ``1/duration`` jumps at both corners and
+    its second derivative is returned as 0 everywhere (the Dirac impulses at the corners are not
+    representable); the corners belong to the ramp on the left, ``[start, start + duration)``.
+    With ``smooth = True`` it is the quintic smoothstep ``10x³ - 15x⁴ + 6x⁵``, ``x = (t - start) /
+    duration``, whose first and second derivatives vanish at both ends: C2, so a support motion
+    built on it has a continuous velocity and acceleration.
+    """
+
+    duration: float
+    start: float = 0.0
+    smooth: bool = False
+    kind: ClassVar[str] = "ramp"
+
+    def _evaluate(self, t):
+        d = self.duration
+        x = (t - self.start) / d
+        inside = (x >= 0.0) & (x < 1.0)
+        xc = np.clip(x, 0.0, 1.0)
+        if self.smooth:
+            f = xc**3 * (10.0 - 15.0 * xc + 6.0 * xc**2)
+            df = 30.0 * xc**2 * (1.0 - xc) ** 2 / d
+            d2f = 60.0 * xc * (1.0 - xc) * (1.0 - 2.0 * xc) / d**2
+            return f, df, d2f
+        return xc, np.where(inside, 1.0 / d, 0.0), 0.0
+
+
+@dataclass(frozen=True)
+class Sine(TimeFunction):
+    """``f(t) = offset + amplitude sin(2π frequency t + phase)``; frequency in Hz, phase in rad."""
+
+    amplitude: float
+    frequency: float
+    phase: float = 0.0
+    offset: float = 0.0
+    kind: ClassVar[str] = "sine"
+
+    def _evaluate(self, t):
+        w = 2.0 * math.pi * self.frequency
+        arg = w * t + self.phase
+        s, c = np.sin(arg), np.cos(arg)
+        a = self.amplitude
+        return self.offset + a * s, a * w * c, -a * w * w * s
+
+
+@dataclass(frozen=True)
+class Cosine(TimeFunction):
+    """``f(t) = offset + amplitude cos(2π frequency t + phase)``; frequency in Hz, phase in rad."""
+
+    amplitude: float
+    frequency: float
+    phase: float = 0.0
+    offset: float = 0.0
+    kind: ClassVar[str] = "cosine"
+
+    def _evaluate(self, t):
+        w = 2.0 * math.pi * self.frequency
+        arg = w * t + self.phase
+        s, c = np.sin(arg), np.cos(arg)
+        a = self.amplitude
+        return self.offset + a * c, -a * w * s, -a * w * w * c
+
+
+@dataclass(frozen=True)
+class Table(TimeFunction):
+    """Cubic-spline interpolation of the points ``(t[i], value[i])``, ``t`` strictly increasing.
+
+    Inside ``[t[0], t[-1]]`` the interpolant is ``scipy.interpolate.CubicSpline`` with *clamped*
+    ends (zero slope at the first and last point): it passes through every point and is C2 there.
+    Outside the range the function is held at its end value with zero derivatives. Because the
+    slope is already zero at the ends, the value and the velocity stay continuous across them
+    (C1); only the second derivative may jump there. ``file`` records where the points came from
+    (as written in the case file), or is ``None`` for inline points.
+    """
+
+    t: tuple[float, ...]
+    value: tuple[float, ...]
+    file: str | None = None
+    kind: ClassVar[str] = "table"
+    _spline: CubicSpline = field(init=False, repr=False, compare=False, hash=False)
+
+    def __post_init__(self):
+        spline = CubicSpline(np.asarray(self.t, float), np.asarray(self.value, float),
+                             bc_type="clamped")
+        # A cache derived from the frozen fields, set once here and never changed.
+        object.__setattr__(self, "_spline", spline)
+
+    def _evaluate(self, t):
+        t0, t1 = self.t[0], self.t[-1]
+        tc = np.clip(t, t0, t1)
+        inside = (t >= t0) & (t <= t1)
+        sp = self._spline
+        return sp(tc), np.where(inside, sp(tc, 1), 0.0), np.where(inside, sp(tc, 2), 0.0)
+
+
+ONE = Constant(1.0)
+"""The factor of a load with no ``time``: the load is constant."""
+
+ZERO = Constant(0.0)
+"""The displacement of a support axis with no motion."""
+
+
+def evaluate_or(func: TimeFunction | None, t, *, absent: TimeFunction) -> tuple:
+    """``func.evaluate(t)``, or ``absent.evaluate(t)`` when ``func`` is ``None``.
+
+    Use ``absent=ONE`` for load factors and ``absent=ZERO`` for support-motion axes.
+    """
+    return (absent if func is None else func).evaluate(t)
