@@ -384,14 +384,14 @@ def case_from_dict(data: Mapping[str, Any], *, path: str | None = None, text: st
 
 
 def _looks_like_path(obj: Any) -> bool:
-    if not isinstance(obj, str) or "\n" in obj or "=" in obj:
+    if not isinstance(obj, str) or "\n" in obj:
         return False
-    if obj.strip().endswith(".toml"):
-        return True
     try:
-        return Path(obj).is_file()
+        if Path(obj).is_file():
+            return True
     except (OSError, ValueError):
         return False
+    return obj.strip().endswith(".toml") and "=" not in obj
 
 
 def _toml_message(msg: str) -> str:
@@ -911,7 +911,9 @@ class _Builder:
             v, complete = self.validate(model, item, where)
             if v is None:
                 continue
-            ok = self.location(v, where, cables) and complete
+            # a location key that was present but bad is already reported: don't guess
+            placed = not any(k in item and getattr(v, k) is None for k in ("node", "cable", "s"))
+            ok = placed and self.location(v, where, cables) and complete
             time = None
             if section == "loads" and v.time is not None:
                 time = self.time_function(v.time, where + ("time",))
@@ -1018,7 +1020,7 @@ class _Builder:
                 ok = False
             else:
                 seen[v.node] = i
-            if v.x is None and v.y is None and v.z is None:
+            if not any(axis in item for axis in AXES):
                 self.problem(where, "a support motion needs at least one of x, y, z")
                 ok = False
             funcs = {}

@@ -378,6 +378,19 @@ def test_bad_input_names_the_field(changes, path, fragments):
         assert fragment in found[path]
 
 
+@pytest.mark.parametrize("changes", [
+    {"cables/0/elements": 0}, {"cables/0/material": 3}, {"materials/strand/EA": -1.0},
+    {"nodes/B": [1.0, 2.0]}, {"support_motions/0/y": 3}, {"loads/0/node": 3},
+    {"point_masses/0/s": "x"}, {"steps/1/remove": "hung"}, {"loads/0/time": {"kind": 1}},
+    {"supports/A": "fixed"},
+])
+def test_one_mistake_gives_one_problem(changes):
+    """A bad item is left out of the cross checks without cascading into more errors."""
+    with pytest.raises(CaseError) as info:
+        load_case(dump(base(**changes)))
+    assert len(info.value.problems) == 1, info.value.problems
+
+
 def test_slack_weightless_cable_has_no_shape():
     data = base(gravity=0.0, point_masses=[], loads=[], steps=[{"kind": "static"}])
     found = problems(data)
