@@ -1,6 +1,6 @@
 """TOML case file -> validated, frozen model of the scene and its analysis steps.
 
-``load_case`` reads a case file (``/work/shared/case-format.md`` names every key) and returns a
+``load_case`` reads a case file (the public format, case-format.md, names every key) and returns a
 :class:`Case`: frozen dataclasses, tuples and read-only mappings, nothing mutable. Reading works
 in three passes, and every problem of every pass is collected before anything is raised, so that a
 single :class:`~catdae.errors.CaseError` lists all of them with their field paths
