@@ -206,6 +206,39 @@ def _cold_start(c, l0, ea, w, ls, lf, k0, k1, h):
         # weightless and not taut: slack unless the loads pull it straight; start small
         for m in range(3):
             h[m] = 1e-6 * ea * c[m] / lc
+    if k1 == k0 and w > 0.0 and lh < 0.05 * lc:
+        _steep_start(c, l0, ea, w, lh, h)
+
+
+@njit(cache=True)
+def _steep_start(c, l0, ea, w, lh, h):
+    """Start for a (nearly) vertical chord: the hanging bar, then H from its lateral flexibility.
+
+    With H = 0 and u = V + w s of one sign, Δz = ±L0 + L0 (V + w L0/2)/EA is linear in V;
+    if neither sign fits, the cable folds (V of the folded bar). H follows from
+    Δx = Hx (L0/EA + ∫ds/T) evaluated on that bar.
+    """
+    lz = c[2]
+    half = 0.5 * w * l0
+    v_up = (lz - l0) * ea / l0 - half  # u > 0 everywhere (t points up the cable)
+    v_dn = (lz + l0) * ea / l0 - half  # u < 0 everywhere (t points down the cable)
+    if v_up > 0.0:
+        v = v_up
+    elif v_dn + w * l0 < 0.0:
+        v = v_dn
+    else:
+        v = (lz - l0 - half * l0 / ea) / (2.0 / w + l0 / ea)
+    d = np.empty(3)
+    f = np.empty(6)
+    ok = _partial(0.0, 0.0, v, w, ea, l0, np.empty(0), np.empty((0, 3)), 0, 0, d, f, True)
+    if ok and np.isfinite(f[0]) and f[0] > 0.0:
+        h[0] = c[0] / f[0]
+        h[1] = c[1] / f[0]
+    else:
+        scale = 1e-3 * max(abs(v), w * l0) / max(lh, 1e-300)
+        h[0] = c[0] * scale
+        h[1] = c[1] * scale
+    h[2] = v
 
 
 @njit(cache=True)
@@ -260,9 +293,20 @@ def _solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout
             dn += dh[m] * dh[m]
         hn = np.sqrt(hn)
         dn = np.sqrt(dn)
+        if dn <= tol * (hn + hscale_extra):
+            # the Newton correction is below the requested accuracy: take it and stop
+            for m in range(3):
+                ht[m] = h[m] + dh[m]
+            if _partial(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True):
+                for m in range(3):
+                    h[m] = ht[m]
+                for m in range(6):
+                    f[m] = ft[m]
+            status = CONVERGED
+            break
         alpha = 1.0
         accepted = False
-        for _ in range(60):
+        for _ in range(36):
             for m in range(3):
                 ht[m] = h[m] + alpha * dh[m]
             okt = _partial(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True)
@@ -271,14 +315,14 @@ def _solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout
                 dt[m] -= c[m]
                 rt += dt[m] * dt[m]
             rt = np.sqrt(rt)
-            if okt and np.isfinite(rt) and rt <= (1.0 - 1e-4 * alpha) * rn:
+            if okt and np.isfinite(rt) and rt < (1.0 - 1e-4 * alpha) * rn:
                 accepted = True
                 break
             alpha *= 0.5
         step_small = alpha * dn <= tol * (hn + hscale_extra)
         if not accepted:
-            # no decrease possible: converged if the residual is at round-off level
-            if rn <= 1e-11 * rscale or dn <= tol * (hn + hscale_extra):
+            # no decrease possible: converged if the residual is at its round-off floor
+            if rn <= 1e-12 * rscale:
                 status = CONVERGED
             break
         for m in range(3):
@@ -351,6 +395,122 @@ def _tension_batch(h, w, ptr, ls, lf, s, tout):
             tout[e, j, 0] = tx
             tout[e, j, 1] = ty
             tout[e, j, 2] = tz
+
+
+@njit(cache=True, inline="always")
+def _add_ntn(g6, kk, frac, slack, scale, out):
+    """out (6, 6) += scale * NᵀN with N = [I - B, B], B = G K (§6); slack: B = frac I."""
+    b = np.empty((3, 3))
+    if slack:
+        for r in range(3):
+            for c in range(3):
+                b[r, c] = frac if r == c else 0.0
+    else:
+        g00, g01, g02, g11, g12, g22 = g6[0], g6[1], g6[2], g6[3], g6[4], g6[5]
+        for c in range(3):
+            b[0, c] = g00 * kk[0, c] + g01 * kk[1, c] + g02 * kk[2, c]
+            b[1, c] = g01 * kk[0, c] + g11 * kk[1, c] + g12 * kk[2, c]
+            b[2, c] = g02 * kk[0, c] + g12 * kk[1, c] + g22 * kk[2, c]
+    for r in range(3):
+        for c in range(3):
+            bb = 0.0
+            ab = 0.0
+            aa = 0.0
+            for k in range(3):
+                ak_r = (1.0 if k == r else 0.0) - b[k, r]
+                ak_c = (1.0 if k == c else 0.0) - b[k, c]
+                bb += b[k, r] * b[k, c]
+                ab += ak_r * b[k, c]
+                aa += ak_r * ak_c
+            out[r, c] += scale * aa
+            out[r, 3 + c] += scale * ab
+            out[3 + c, r] += scale * ab
+            out[3 + r, 3 + c] += scale * bb
+
+
+@njit(cache=True)
+def _mass_one(he, kk, slack, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm1, pms,
+              pmm, with_points, out, x, g6):
+    """out (6, 6) = Σ_g scale L0 w_g N(s_g)ᵀ N(s_g) (+ Σ_p m_p N(s_p)ᵀ N(s_p)), §6-7."""
+    out[:, :] = 0.0
+    for j in range(gs_e.shape[0]):
+        wt = gw_e[j]
+        if wt == 0.0:
+            continue
+        if not slack:
+            _partial(he[0], he[1], he[2], w, ea, gs_e[j], ls, lf, k0, k1, x, g6, True)
+        _add_ntn(g6, kk, gs_e[j] / l0, slack, scale_e * l0 * wt, out)
+    if with_points:
+        for p in range(pm0, pm1):
+            if not slack:
+                _partial(he[0], he[1], he[2], w, ea, pms[p], ls, lf, k0, k1, x, g6, True)
+            _add_ntn(g6, kk, pms[p] / l0, slack, pmm[p], out)
+
+
+@njit(cache=True)
+def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
+                    pmptr, pms, pmm, want_c, fflat, kmat, its, stat, mout, cout):
+    """Solve every element and build its consistent mass (and damping) matrix (§6-7).
+
+    M_e = Σ_g m L0 w_g N(s_g)ᵀ N(s_g) + Σ_p m_p N(s_p)ᵀ N(s_p); C_e the same with c for m
+    (point masses carry no material damping). Point masses inside elements: CSR ``pmptr``.
+    """
+    x = np.empty(3)
+    g6 = np.empty(6)
+    for e in range(chord.shape[0]):
+        its[e], stat[e] = _solve_one(
+            chord[e], l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h[e], use_h, tol,
+            max_iter, fflat[e], kmat[e],
+        )
+        slack = stat[e] == SLACK
+        _mass_one(h[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], gs[e],
+                  gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mout[e], x, g6)
+        if want_c:
+            _mass_one(h[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+                      gs[e], gw[e], cq[e], 0, 0, pms, pmm, False, cout[e], x, g6)
+
+
+@njit(cache=True)
+def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, tol, max_iter, gs, gw, mq,
+                         pmptr, pms, pmm, dout):
+    """∂M_e/∂c_k (n, 3, 6, 6) by central differences of the chord c = x_j - x_i.
+
+    M_e depends on the nodes only through the chord. The step is 1e-4 of |F h|, the chord
+    change that alters the tension by its own size, so it suits taut and slack elements alike.
+    """
+    x = np.empty(3)
+    g6 = np.empty(6)
+    f6 = np.empty(6)
+    kk = np.empty((3, 3))
+    ht = np.empty(3)
+    ct = np.empty(3)
+    mt = np.empty((6, 6))
+    for e in range(chord.shape[0]):
+        fe = fflat[e]
+        he = h[e]
+        fh0 = fe[0] * he[0] + fe[1] * he[1] + fe[2] * he[2]
+        fh1 = fe[1] * he[0] + fe[3] * he[1] + fe[4] * he[2]
+        fh2 = fe[2] * he[0] + fe[4] * he[1] + fe[5] * he[2]
+        scale = np.sqrt(fh0 * fh0 + fh1 * fh1 + fh2 * fh2)
+        if not np.isfinite(scale):
+            scale = l0[e]
+        delta = max(1e-4 * min(scale, l0[e]), 1e-12 * l0[e])
+        dout[e, :, :, :] = 0.0
+        for k in range(3):
+            for sgn in (1.0, -1.0):
+                for m in range(3):
+                    ct[m] = chord[e, m]
+                    ht[m] = he[m]
+                ct[k] += sgn * delta
+                _, st = _solve_one(ct, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], ht, True,
+                                   tol, max_iter, f6, kk)
+                if st == NOT_CONVERGED:
+                    continue
+                _mass_one(ht, kk, st == SLACK, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+                          gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
+                for r in range(6):
+                    for c in range(6):
+                        dout[e, k, r, c] += sgn * mt[r, c] / (2.0 * delta)
 
 
 def _sym_from_upper(f6: np.ndarray) -> np.ndarray:
@@ -474,7 +634,7 @@ class Elements:
     def _h(self, h) -> np.ndarray:
         return np.ascontiguousarray(np.broadcast_to(np.asarray(h, float), (self.n, 3)))
 
-    def solve(self, chord, h0=None, *, tol: float = 1e-12, max_iter: int = 60) -> ElementState:
+    def solve(self, chord, h0=None, *, tol: float = 1e-12, max_iter: int = 100) -> ElementState:
         """Tension h such that the element spans ``chord`` (n, 3) = x_j - x_i.
 
         ``h0`` warm-starts Newton (the previous state's h); without it a cold start is used.
@@ -491,6 +651,61 @@ class Elements:
         _solve_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, h, use_h,
                      tol, max_iter, f6, kmat, its, stat)
         return ElementState(h, _sym_from_upper(f6), kmat, its, stat)
+
+    def solve_dynamic(self, chord, h0, gauss_s, gauss_w, m, c=None, point_masses=None,
+                      *, tol: float = 1e-12, max_iter: int = 100):
+        """Solve the elements and build their consistent mass (and damping) matrices.
+
+        ``gauss_s``/``gauss_w`` (n, g): points (m) and weights (sum 1 per element); ``m`` and
+        ``c`` (n,): mass and damping per unstrained length; ``point_masses`` = (element (p,),
+        s (p,), mass (p,)) inside elements. Returns (ElementState, M_e (n, 6, 6),
+        C_e (n, 6, 6) or None) in one compiled pass.
+        """
+        chord = np.ascontiguousarray(chord, float).reshape(self.n, 3)
+        use_h = h0 is not None
+        h = np.array(h0, float).reshape(self.n, 3) if use_h else np.zeros((self.n, 3))
+        f6 = np.empty((self.n, 6))
+        kmat = np.empty((self.n, 3, 3))
+        its = np.empty(self.n, np.int64)
+        stat = np.empty(self.n, np.int64)
+        me = np.empty((self.n, 6, 6))
+        want_c = c is not None
+        ce = np.empty((self.n, 6, 6)) if want_c else np.empty((1, 6, 6))
+        cq = np.ascontiguousarray(c, float) if want_c else np.zeros(self.n)
+        pmptr, pms, pmm = self._point_mass_csr(point_masses)
+        gs = np.ascontiguousarray(gauss_s, float)
+        gw = np.ascontiguousarray(gauss_w, float)
+        mq = np.ascontiguousarray(m, float)
+        _dynamics_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, h,
+                        use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm, want_c,
+                        f6, kmat, its, stat, me, ce)
+        state = ElementState(h, _sym_from_upper(f6), kmat, its, stat)
+        self._last_dynamic = (chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter)
+        return state, me, (ce if want_c else None)
+
+    def mass_gradient(self, state: ElementState) -> np.ndarray:
+        """∂M_e/∂c_k, (n, 3, 6, 6), about the state of the last ``solve_dynamic`` call."""
+        chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter = self._last_dynamic
+        out = np.empty((self.n, 3, 6, 6))
+        _mass_gradient_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf,
+                             state.h, f6, tol, max_iter, gs, gw, mq, pmptr, pms, pmm, out)
+        return out
+
+    def _point_mass_csr(self, point_masses):
+        key = id(point_masses)
+        cached = getattr(self, "_pm_cache", None)
+        if cached is not None and cached[0] == key:
+            return cached[1]
+        if point_masses is None or len(point_masses[0]) == 0:
+            csr = (np.zeros(self.n + 1, np.int64), np.zeros(0), np.zeros(0))
+        else:
+            e, s, mass = (np.asarray(a) for a in point_masses)
+            order = np.lexsort((s, e))
+            ptr = np.concatenate([[0], np.cumsum(np.bincount(e, minlength=self.n))])
+            csr = (ptr.astype(np.int64), np.ascontiguousarray(s[order], float),
+                   np.ascontiguousarray(mass[order], float))
+        self._pm_cache = (key, csr, point_masses)
+        return csr
 
     def _partial(self, h, s, want_flex: bool):
         h = self._h(h)
