@@ -99,6 +99,7 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
         model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, 0.0),
         {"iterations": sol.iterations, "residual_norm": sol.residual_norm,
          "load_increments": sol.load_steps, "status": "completed"},
+        cables=model.cable_summary(sol.X, sol.state),
     )
 
 

@@ -281,6 +281,21 @@ class Model:
                 me[e[k]] += ld.mass_value[k] * nk.T @ nk
         return me
 
+    def dynamic_state(self, X: np.ndarray, h0: np.ndarray | None, material_damping: bool):
+        """Element state with element mass (and material damping) matrices in one pass.
+
+        Returns (state, M_e (n_elem, 6, 6) or None when the mass is lumped, C_e or None).
+        """
+        mesh = self.mesh
+        ld = self.loading
+        state, me, ce = self.elements.solve_dynamic(
+            self.chords(X), h0, self.gauss_s, self.gauss_w, mesh.m,
+            mesh.c if material_damping and self.mass_model == "consistent" else None,
+            (ld.mass_elem, ld.mass_s, ld.mass_value))
+        if self.mass_model == "lumped":
+            me = None
+        return state, me, ce
+
     def lumped_mass_diag(self) -> np.ndarray:
         """Lumped masses on the dofs: half of each element's mass at each end, (n_dof,) kg."""
         mesh = self.mesh
@@ -331,3 +346,34 @@ class Model:
     def tensions(self, state: ElementState) -> np.ndarray:
         """Tension at ends i and j of every element, (n_elem, 2) N."""
         return self.elements.end_tensions(state.h)
+
+    def cable_summary(self, X: np.ndarray, state: ElementState) -> dict[str, np.ndarray]:
+        """Per cable: tension at its two ends, horizontal tension at its first end, and sag.
+
+        Sag is the largest vertical distance from the chord to the cable (sampled on the exact
+        curve of every element); for a vertical chord, the largest distance from the chord.
+        """
+        mesh = self.mesh
+        nc = len(mesh.cable_names)
+        end_t = np.zeros((nc, 2))
+        h_t = np.zeros(nc)
+        sag = np.zeros(nc)
+        tens = self.tensions(state)
+        s = np.linspace(0.0, 1.0, 17)[None, :] * mesh.L0[:, None]  # (n_elem, 17)
+        pts = X[mesh.conn[:, 0]][:, None, :] + self.elements.position(state.h, s)
+        for ci in range(nc):
+            els = np.flatnonzero(mesh.cable_of_element == ci)
+            end_t[ci] = tens[els[0], 0], tens[els[-1], 1]
+            h_t[ci] = float(np.hypot(*state.h[els[0], :2]))
+            a = X[mesh.conn[els[0], 0]]
+            b = X[mesh.conn[els[-1], 1]]
+            p = pts[els].reshape(-1, 3) - a
+            c = b - a
+            ch = np.hypot(c[0], c[1])
+            if ch > 1e-9 * np.linalg.norm(c):
+                frac = (p[:, :2] @ c[:2]) / ch**2
+                sag[ci] = float(np.max(frac * c[2] - p[:, 2]))
+            else:
+                u = c / np.linalg.norm(c)
+                sag[ci] = float(np.max(np.linalg.norm(p - np.outer(p @ u, u), axis=1)))
+        return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag}

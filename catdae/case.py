@@ -219,7 +219,9 @@ class Step:
     ``remove`` names point masses or loads taken away from this step on. Static: ``load_steps``.
     Modal: ``modes``, ``mass_model``. Transient: ``duration`` and ``output_interval`` (s),
     ``rtol``, ``atol``, ``damping``, ``max_order`` (IDA's BDF order limit), ``linear_solver``,
-    ``mass_model``.
+    ``mass_model``, ``inertia`` ("lagrangian": M(q) v' plus the velocity terms of Lagrange's
+    equations for T = ½ vᵀ M(q) v, which conserve energy; "paper": M(q) v' alone, the form of
+    Chang, Park & Lee 2008, which does not).
     """
 
     kind: Literal["static", "modal", "transient"]
@@ -235,6 +237,7 @@ class Step:
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["consistent", "lumped"] = "consistent"
     load_steps: int = 1
+    inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 
 @dataclass(frozen=True)
@@ -516,6 +519,7 @@ class _TransientStep(BaseModel):
     max_order: Annotated[int, Field(ge=1, le=5)] = 5
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["consistent", "lumped"] = "consistent"
+    inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 
 _STEP_MODELS: dict[str, type[BaseModel]] = {
@@ -1099,7 +1103,7 @@ class _Builder:
                 extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
-                         "mass_model": v.mass_model}
+                         "mass_model": v.mass_model, "inertia": v.inertia}
             if complete:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove), **extra))
         return out

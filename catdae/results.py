@@ -52,8 +52,11 @@ def clean_attrs(attrs: dict) -> dict:
 
 
 def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.ndarray,
-                   attrs: dict) -> xr.Dataset:
-    """One static step: positions (n_nodes, 3), tensions (n_elem, 2), reactions (n_nodes, 3)."""
+                   attrs: dict, cables: dict | None = None) -> xr.Dataset:
+    """One static step: positions (n_nodes, 3), tensions (n_elem, 2), reactions (n_nodes, 3).
+
+    ``cables`` (from Model.cable_summary) adds per-cable end tensions, horizontal tension, sag.
+    """
     d = ("node", "axis")
     ds = xr.Dataset(
         {
@@ -68,6 +71,15 @@ def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.
         coords=_coords(mesh),
         attrs=clean_attrs({"kind": "static", **attrs}),
     )
+    if cables is not None:
+        ds = ds.assign_coords(cable=xr.Variable("cable", np.array(mesh.cable_names, dtype=object),
+                                                {"long_name": "cable name"}))
+        ds["cable_end_tension"] = _var(("cable", "end"), cables["end_tension"], "N",
+                                       "tension at the cable's first (i) and last (j) end")
+        ds["horizontal_tension"] = _var("cable", cables["horizontal_tension"], "N",
+                                        "horizontal tension at the cable's first end")
+        ds["sag"] = _var("cable", cables["sag"], "m",
+                         "largest vertical distance from chord to cable")
     return ds
 
 

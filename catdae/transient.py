@@ -18,11 +18,21 @@ iteration matrix, see ../shared/ida-notes.md). A trial state where an element ca
 is answered with NaN in the residual, which IDA treats as recoverable: it retries with a smaller
 step. Output is interpolated by IDA at the output times without shortening its own steps.
 
-Energy: the semi-discrete equations with a configuration-dependent M(q) and without the
-dM/dq v terms are not derived from a Lagrangian, so the total energy (kinetic + strain +
-gravity) of an undamped motion is not an exact invariant of them; it is recorded at every output
-(``energy_total``) so that its drift can be measured. In free vibration the drift is bounded by
-the integration error and shrinks as the tolerance tightens (tests/test_transient.py).
+Inertia (``inertia`` of a transient step). The paper's form keeps M(q) v' alone. With a
+configuration-dependent M(q) that form is not derived from a kinetic energy: the power balance
+misses ½ vᵀ Ṁ v, and where M(q) oscillates fast (axial waves in a slack cable change the element
+sag, hence N(s) and M, at kHz) this pumps energy into the motion until it blows up (seen on the
+paper's example 2, gentle scene, within 3 s). The default ``inertia = "lagrangian"`` adds the
+velocity terms of Lagrange's equations for T = ½ vᵀ M(q) v:
+
+    r_v = M v' + Ṁ v - ∂T/∂q + C v + F - P,   Ṁ_e = Σ_k ∂M_e/∂c_k ċ_k
+
+where an element's M_e depends on the nodes only through its chord c = x_j - x_i, so
+∂T/∂u_j = -∂T/∂u_i = ½ v_eᵀ (∂M_e/∂c) v_e. ∂M_e/∂c is taken by central differences inside the
+compiled kernel (six warm element solves per element). The undamped semi-discrete system is then
+conservative: the total energy (kinetic + strain + gravity, recorded as ``energy_total``) drifts
+only by the integration error, which shrinks as the tolerance tightens (tests). ``"paper"``
+reproduces the paper's equations for comparison; a lumped mass has no such terms.
 """
 
 from __future__ import annotations
@@ -31,6 +41,7 @@ import sys
 import time as _time
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 import xarray as xr
@@ -93,7 +104,25 @@ class TransientProblem:
         self.alpha = self.beta = 0.0
         if self.damping is not None and self.damping.kind == "rayleigh":
             self.alpha, self.beta = self.damping.coefficients()
+        self.material = self.damping is not None and self.damping.kind == "material"
+        self.lagrangian = step.inertia == "lagrangian" and (
+            model.mass_model == "consistent")
+        nd = model.n_dof
+        if model.mass_model == "lumped":
+            self.m_diag = model.lumped_mass_diag()
+            self.c_diag = np.zeros(nd)
+            if self.material:
+                mesh = model.mesh
+                node = np.zeros(mesh.n_nodes)
+                np.add.at(node, mesh.conn.ravel(), np.repeat(0.5 * mesh.c * mesh.L0, 2))
+                self.c_diag = np.repeat(node, 3)
+        else:
+            self.m_diag = np.repeat(model.loading.node_mass, 3)
+            self.c_diag = np.zeros(nd)
         # --- work arrays and state
+        self._cache_t = None
+        self._cache_q = None
+        self._cache = None
         self.X = np.array(X0, float).reshape(-1).copy()
         self.h = None if h0 is None else np.array(h0, float, copy=True)
         self._support_t = None
@@ -110,35 +139,29 @@ class TransientProblem:
             self._support_t = t
         return self._sup
 
-    def configuration(self, t: float, q: np.ndarray) -> ElementState | None:
-        """Element state for free positions q at time t, or None if an element fails."""
+    def configuration(self, t: float, q: np.ndarray):
+        """(state, M_e, C_e) for free positions q at time t, or None if an element fails.
+
+        The last evaluation is cached: IDA calls the iteration matrix at the state of the
+        residual it has just evaluated.
+        """
+        if self._cache_t == t and np.array_equal(self._cache_q, q):
+            return self._cache
         m = self.model
         xp, _, _ = self._supports(t)
         self.X[self.fidx] = q
         self.X[m.fixed] = xp
         m.set_time(t)
-        state = m.elements.solve(m.chords(self.X.reshape(-1, 3)), self.h)
-        if (state.status == NOT_CONVERGED).any():
-            return None
-        if not np.all(np.isfinite(state.h)):
-            return None
-        self.h = state.h
-        return state
-
-    def matrices(self, state: ElementState, with_k: bool):
-        """CSR data of M, C (or None) and K_t (if needed) on the full dof set."""
-        m = self.model
-        mdata = m.mass_data(state)
-        kdata = m.stiffness_data(state) if (with_k or self.beta) else None
-        cdata = None
-        if self.damping is not None:
-            if self.damping.kind == "material":
-                cdata = m.material_damping_data(state)
-            else:
-                cdata = self.alpha * mdata
-                if self.beta:
-                    cdata = cdata + self.beta * kdata
-        return mdata, cdata, kdata
+        out = m.dynamic_state(self.X.reshape(-1, 3), self.h, self.material)
+        state = out[0]
+        if (state.status == NOT_CONVERGED).any() or not np.all(np.isfinite(state.h)):
+            out = None
+        else:
+            self.h = state.h
+            dm = m.elements.mass_gradient(state) if self.lagrangian else None
+            out = (*out, dm)
+        self._cache_t, self._cache_q, self._cache = t, np.array(q, copy=True), out
+        return out
 
     def full_vectors(self, t: float, v: np.ndarray, vd: np.ndarray):
         m = self.model
@@ -151,27 +174,76 @@ class TransientProblem:
         A[m.fixed] = ap
         return V, A
 
-    def dynamic_force(self, t, state, V, A):
-        """M A + C V + F - P on the full dof set, (n_dof,) N."""
+    def dynamic_force(self, t, conf, V, A):
+        """M A + C V + F - P on the full dof set, (n_dof,) N, from element blocks."""
         m = self.model
-        mdata, cdata, _ = self.matrices(state, with_k=False)
-        out = m.pattern.matrix(mdata) @ A + m.internal_force(state) - m.nodal_load(t)
-        if cdata is not None:
-            out += m.pattern.matrix(cdata) @ V
+        state, me, ce, dm = conf
+        ed = m.edofs
+        a_e = A[ed]  # (n_elem, 6)
+        fe = m.elements.end_forces(state.h).reshape(-1, 6)
+        if me is not None:
+            fe = fe + (me @ a_e[:, :, None])[:, :, 0]
+        if dm is not None:
+            # velocity terms of Lagrange's equations with T = ½ vᵀ M(c) v, c = x_j - x_i:
+            # Ṁ v - ∂T/∂q, Ṁ_e = Σ_k ∂M_e/∂c_k ċ_k; ∂T/∂u_j = -∂T/∂u_i = ½ vᵀ ∂M_e/∂c v
+            v_e = V[ed]
+            cdot = v_e[:, 3:] - v_e[:, :3]  # (n_elem, 3)
+            dmv = dm @ v_e[:, None, :, None]  # (n_elem, 3, 6, 1)
+            fe += np.einsum("ek,eki->ei", cdot, dmv[..., 0])
+            half = 0.5 * np.einsum("ei,eki->ek", v_e, dmv[..., 0])  # (n_elem, 3)
+            fe[:, :3] += half
+            fe[:, 3:] -= half
+        if self.damping is not None:
+            v_e = V[ed]
+            if ce is not None:
+                fe += (ce @ v_e[:, :, None])[:, :, 0]
+            if self.alpha and me is not None:
+                fe += self.alpha * (me @ v_e[:, :, None])[:, :, 0]
+            if self.beta:
+                dv = v_e[:, :3] - v_e[:, 3:]
+                kd = (state.K @ dv[:, :, None])[:, :, 0]
+                fe += self.beta * np.concatenate([kd, -kd], axis=1)
+        out = np.bincount(ed.ravel(), weights=fe.ravel(), minlength=self.n_dof)
+        out += self.m_diag * A - m.nodal_load(t)
+        if self.damping is not None:
+            out += (self.c_diag + self.alpha * self.m_diag) * V
         return out
+
+    def blocks(self, conf, cj):
+        """CSR data (full dofs) of K_t and of cj M + C."""
+        m = self.model
+        state, me, ce, _ = conf
+        k6 = state.stiffness6
+        kdata = m.pattern.assemble(k6)
+        vv = np.zeros_like(k6)
+        if me is not None:
+            vv += (cj + self.alpha) * me
+        if ce is not None:
+            vv += ce
+        if self.beta:
+            vv += self.beta * k6
+        diag = (cj + self.alpha) * self.m_diag + self.c_diag
+        return kdata, m.pattern.assemble(vv, diag)
+
+    def mass_data(self, conf) -> np.ndarray:
+        """CSR data (full dofs) of M(q)."""
+        return self.model.pattern.assemble(conf[1], self.m_diag)
+
+    def ff(self, data: np.ndarray) -> sp.csr_matrix:
+        """Free-free block (in the unknowns' order) of full-dof CSR data."""
+        return sp.csr_matrix((data[self.ff_sel], (self.ff_a, self.ff_b)), shape=(self.n,) * 2)
 
     # ------------------------------------------------------------------ IDA callbacks
     def resfn(self, t, y, yp, res):
         self.n_res += 1
         try:
-            q = y[0::2]
-            state = self.configuration(t, q)
-            if state is None:
+            conf = self.configuration(t, y[0::2])
+            if conf is None:
                 self.n_rejected += 1
                 res[:] = np.nan
                 return
             V, A = self.full_vectors(t, y[1::2], yp[1::2])
-            f = self.dynamic_force(t, state, V, A)
+            f = self.dynamic_force(t, conf, V, A)
             res[0::2] = yp[0::2] - y[1::2]
             res[1::2] = f[self.fidx]
         except (FloatingPointError, ValueError, ZeroDivisionError, np.linalg.LinAlgError):
@@ -179,15 +251,12 @@ class TransientProblem:
             res[:] = np.nan
 
     def _jac_parts(self, t, y, cj):
-        state = self.configuration(t, y[0::2])
-        if state is None:
+        conf = self.configuration(t, y[0::2])
+        if conf is None:
             return None
-        mdata, cdata, kdata = self.matrices(state, with_k=True)
+        kdata, vdata = self.blocks(conf, cj)
         sel = self.ff_sel
-        vv = cj * mdata[sel]
-        if cdata is not None:
-            vv = vv + cdata[sel]
-        return kdata[sel], vv
+        return kdata[sel], vdata[sel]
 
     def jac_dense(self, t, y, yp, res, cj, JJ):
         """Iteration matrix into the full (2n, 2n) array (dense and band solvers)."""
@@ -224,15 +293,13 @@ class TransientProblem:
         """Consistent y0, yp0: v'(0) = M⁻¹ (P - C v - F - coupling) on the free dofs."""
         q0 = X.reshape(-1)[self.fidx]
         v0 = V.reshape(-1)[self.fidx]
-        state = self.configuration(t0, q0)
-        if state is None:
+        conf = self.configuration(t0, q0)
+        if conf is None:
             raise SolverError("transient start: an element cannot be solved in the initial "
                               "configuration", termination="initial state")
         V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
-        f = self.dynamic_force(t0, state, V_full, A_full)  # M_fp a_p + C v + F - P
-        mdata = self.model.mass_data(state)
-        mff = sp.csr_matrix((mdata[self.ff_sel], (self.ff_a, self.ff_b)), shape=(self.n, self.n))
-        a0 = spla.spsolve(mff.tocsc(), -f[self.fidx])
+        f = self.dynamic_force(t0, conf, V_full, A_full)  # M_fp a_p + C v + F - P
+        a0 = spla.spsolve(self.ff(self.mass_data(conf)).tocsc(), -f[self.fidx])
         y0 = np.empty(2 * self.n)
         yp0 = np.empty(2 * self.n)
         y0[0::2], y0[1::2] = q0, v0
@@ -242,17 +309,17 @@ class TransientProblem:
     def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
         """Positions, velocities, accelerations, tensions, reactions and energies at t."""
         m = self.model
-        state = self.configuration(t, y[0::2])
-        if state is None:
+        conf = self.configuration(t, y[0::2])
+        if conf is None:
             raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
                               termination="element failure")
+        state = conf[0]
         V, A = self.full_vectors(t, y[1::2], yp[1::2])
         X = self.X.copy()
-        f = self.dynamic_force(t, state, V, A)
+        f = self.dynamic_force(t, conf, V, A)
         reaction = np.full(self.n_dof, np.nan)
         reaction[m.fixed] = f[m.fixed]
-        mdata = m.mass_data(state)
-        kinetic = 0.5 * V @ (m.pattern.matrix(mdata) @ V)
+        kinetic = 0.5 * V @ (m.pattern.matrix(self.mass_data(conf)) @ V)
         strain, gravity = _potential(m, X.reshape(-1, 3), state, t)
         return (X, V, A, m.tensions(state), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
@@ -291,7 +358,7 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
     band = 4 * problem.bandwidth + 3
     if n2 <= 24:
         return "dense"
-    if band <= max(16, n2 // 8):
+    if band <= max(32, n2 // 4):
         return "band"
     return "sparse"
 
@@ -360,7 +427,8 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "wall_time": _time.perf_counter() - wall0, "rtol": step.rtol, "atol": step.atol,
             "atol_velocity": step.atol * omega, "status": status, "linear_solver": linsolver,
             "bandwidth": prob.bandwidth, "max_order": int(step.max_order),
-            "mass_model": model.mass_model,
+            "mass_model": model.mass_model, "inertia": step.inertia if prob.lagrangian else
+            "paper" if model.mass_model == "consistent" else "lumped",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
             "n_outputs": n_valid,
@@ -413,16 +481,11 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
 
 def _reference_frequency(prob: TransientProblem, y0: np.ndarray) -> float:
     """ω of the lowest mode about the start (rad/s): scales the velocity tolerance."""
-    m = prob.model
-    state = prob.configuration(0.0, y0[0::2])
+    conf = prob.configuration(0.0, y0[0::2])
     try:
-        mdata = m.mass_data(state)
-        kdata = m.stiffness_data(state)
-        kff = sp.csr_matrix((kdata[prob.ff_sel], (prob.ff_a, prob.ff_b)), shape=(prob.n,) * 2)
-        mff = sp.csr_matrix((mdata[prob.ff_sel], (prob.ff_a, prob.ff_b)), shape=(prob.n,) * 2)
+        mff = prob.ff(prob.mass_data(conf))
+        kff = prob.ff(prob.model.pattern.assemble(conf[0].stiffness6))
         if prob.n <= 400:
-            import scipy.linalg as sla
-
             lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,
                            subset_by_index=[0, 0])[0]
         else:

@@ -1,0 +1,143 @@
+"""The command line: ``catdae run``, ``catdae check``. No physics here.
+
+Errors become one clear message on stderr and a non-zero exit code:
+1 analysis failed (partial results written), 2 invalid case or usage, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from importlib.resources import files
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+from .errors import CaseError, CatdaeError
+
+DEFAULT_CASE = "example1_free_vibration.toml"
+
+
+def default_case_path() -> Path:
+    """The bundled default case (the paper's example 1)."""
+    return Path(str(files("catdae") / "data" / DEFAULT_CASE))
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="catdae", description="Exact elastic catenary cable "
+                                "analysis: statics, modes and nonlinear dynamics.")
+    p.add_argument("--version", action="version", version=f"catdae {__version__}")
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="run every step of a case and write netCDF results")
+    r.add_argument("case", nargs="?", help="case file (TOML); default: the bundled example 1")
+    r.add_argument("-o", "--output", help="output netCDF file (default: <case stem>.nc)")
+    r.add_argument("--rtol", type=float, help="relative tolerance of transient steps")
+    r.add_argument("--atol", type=float, help="absolute tolerance of transient steps, m")
+    r.add_argument("--elements", type=int, help="elements per cable")
+    r.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar (default: on a terminal)")
+    c = sub.add_parser("check", help="validate a case file and report every problem")
+    c.add_argument("case")
+    s = sub.add_parser("study", help="accuracy and cost studies (work-precision)")
+    s.add_argument("case")
+    s.add_argument("rest", nargs=argparse.REMAINDER)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        if args.command == "check":
+            return _check(args)
+        if args.command == "run":
+            return _run(args)
+        if args.command == "study":
+            from .study import main as study_main
+
+            return study_main([args.case, *args.rest])
+    except CaseError as exc:
+        print(f"catdae: invalid case\n{exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("catdae: interrupted", file=sys.stderr)
+        return 130
+    return 2  # pragma: no cover - argparse requires a command
+
+
+def _check(args) -> int:
+    from .case import load_case
+    from .mesh import build_mesh
+
+    case = load_case(args.case)
+    mesh = build_mesh(case)
+    print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
+          f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
+    return 0
+
+
+def _run(args) -> int:
+    from .analysis import run
+    from .case import load_case
+
+    path = Path(args.case) if args.case else default_case_path()
+    case = load_case(path)
+    out = Path(args.output) if args.output else Path(f"{path.stem}.nc")
+    try:
+        tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
+                   elements=args.elements)
+    except CatdaeError as exc:
+        where = getattr(exc, "output_path", None)
+        print(f"catdae: {path}: {exc}", file=sys.stderr)
+        if where is not None:
+            print(f"catdae: results computed before the failure were written to {where}",
+                  file=sys.stderr)
+        return 1
+    print(summary(tree))
+    print(f"results written to {out}")
+    return 0
+
+
+def summary(tree) -> str:
+    """A short printed summary: per step, what a user looks at first."""
+    lines = [f"{tree.attrs.get('title') or 'catdae run'}"]
+    for name, node in tree.children.items():
+        ds = node.to_dataset()
+        kind = ds.attrs.get("kind", "")
+        if kind == "static":
+            lines.append(f"[{name}] static: {ds.attrs.get('iterations')} Newton iterations, "
+                         f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
+            lines.extend(_cable_lines(ds))
+        elif kind == "modal":
+            f = ", ".join(f"{v:.4g}" for v in ds.frequency.values[:10])
+            lines.append(f"[{name}] modal: frequencies (Hz): {f}")
+        elif kind == "transient":
+            a = ds.attrs
+            lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
+                         f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
+                         f"{a.get('n_residual_evaluations')} residuals, "
+                         f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
+            d = ds.displacement
+            mag = np.sqrt((d**2).sum("axis"))
+            node = str(mag.max("time").idxmax("node").values)
+            lines.append(f"    largest motion at node {node}: "
+                         f"{float(mag.sel(node=node).max()):.4g} m; "
+                         f"max tension {float(ds.tension.max()):.6g} N")
+    return "\n".join(lines)
+
+
+def _cable_lines(ds) -> list[str]:
+    """Per cable: end tensions, horizontal tension, sag."""
+    if "cable" not in ds.coords:
+        return []
+    out = []
+    for k, cab in enumerate(ds.cable.values):
+        t_i, t_j = (float(v) for v in ds.cable_end_tension.values[k])
+        out.append(f"    cable {cab}: end tensions {t_i:.6g} N, {t_j:.6g} N; horizontal tension "
+                   f"{float(ds.horizontal_tension.values[k]):.6g} N; sag "
+                   f"{float(ds.sag.values[k]):.6g} m")
+    return out
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
