@@ -55,7 +55,10 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
         target = min(1.0, lam + dlam)
         model.elements.set_load_forces(target * f_full)
         p = target * p_full
-        ok, X_new, state_new, its, rnorm = _newton(model, X, state, p, fscale, rtol, max_iter)
+        start = model.element_state(X, state.h)  # the loads inside elements changed
+        if (start.status == NOT_CONVERGED).any():
+            start = model.element_state(X)
+        ok, X_new, state_new, its, rnorm = _newton(model, X, start, p, fscale, rtol, max_iter)
         total_iter += its
         if ok:
             X, state, lam = X_new, state_new, target
