@@ -11,4 +11,28 @@ try:
 except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
     __version__ = "0.0.0+unknown"
 
-__all__ = ["CaseError", "CatdaeError", "ConvergenceError", "SolverError", "__version__"]
+
+
+def run(case_or_path, **kwargs):
+    """Run every step of a case (path, TOML text or Case); see :func:`catdae.analysis.run`."""
+    from .analysis import run as _run
+
+    return _run(case_or_path, **kwargs)
+
+
+def load_case(path_or_text, **kwargs):
+    """Read and validate a case file; see :func:`catdae.case.load_case`."""
+    from .case import load_case as _load
+
+    return _load(path_or_text, **kwargs)
+
+
+def read_results(path):
+    """Open a results file written by catdae as an ``xarray.DataTree`` (in memory)."""
+    from .results import read_tree
+
+    return read_tree(path)
+
+
+__all__ = ["CaseError", "CatdaeError", "ConvergenceError", "SolverError", "__version__",
+           "load_case", "read_results", "run"]
