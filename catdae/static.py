@@ -1,8 +1,8 @@
 """Static equilibrium: Newton on the free dofs with the assembled sparse tangent stiffness.
 
 R(X) = Σ_e r_e(X) - P = 0 on the free dofs (formulation.md §4). Each Newton step solves
-K_t dX = -R with the sparse tangent stiffness, and is damped by backtracking on |R| (the Newton
-direction always descends |R|² since K_t is non-singular). Loads beyond the self-weight (point
+K_t dX = -R with the sparse tangent stiffness, and is damped by a line search on the slope of the
+total potential energy along the step (:func:`_line_search`). Loads beyond the self-weight (point
 loads, point masses, distributed loads) are applied in load steps; a load step that fails is
 halved, so that hard starts (a large point load on a slack cable) still converge.
 """
@@ -94,21 +94,72 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
             return False, X, state, it, rn
         if not np.all(np.isfinite(dx)):
             return False, X, state, it, rn
-        alpha = 1.0
-        for _ in range(40):
-            Xt = X.copy()
-            Xt.reshape(-1)[free] += alpha * dx
-            st = model.element_state(Xt, state.h)
-            if not (st.status == NOT_CONVERGED).any():
-                rt = _residual(model, st, p)
-                rtn = np.linalg.norm(rt)
-                if np.isfinite(rtn) and rtn <= (1.0 - 1e-4 * alpha) * rn:
-                    break
-            alpha *= 0.5
-        else:
+        step = _line_search(model, X, state, dx, r, rn, p)
+        if step is None:
             # no decrease: converged to round-off, or stuck
             return rn <= 1e3 * rtol * tscale, X, state, it, rn
-        X, state, r, rn = Xt, st, rt, rtn
+        alpha, X, state, r = step
+        rn = np.linalg.norm(r)
         if alpha == 1.0 and np.abs(dx).max() <= 1e-14 * max(1.0, np.abs(X).max()):
             return True, X, state, it, rn
     return rn <= rtol * fscale, X, state, max_iter, rn
+
+
+def _line_search(model: Model, X, state, dx, r, rn, p):
+    """Step length along the Newton direction ``dx``. Returns (alpha, X, state, R) or None.
+
+    R is the gradient of the total potential energy Π (conservative loads, hyperelastic
+    elements: K_t is symmetric), so φ'(α) = R(X + α dx)·dx is the slope of Π along the step and
+    φ'(0) = -Rᵀ K_t⁻¹ R < 0 when K_t is positive definite. The step is accepted where the slope
+    has fallen to half its start (|φ'(α)| <= |φ'(0)|/2, found by safeguarded secant steps on
+    φ'), or at α = 1 while Π still descends there. Backtracking on |R| instead would accept only
+    tiny steps along the near-inextensional motions of a slack cable: a straight step stretches
+    the elements at second order and |R| jumps by EA times that, although Π falls. Trial
+    states where an element cannot be solved halve the step. When φ'(0) >= 0 (K_t not
+    positive definite) the step backtracks on |R|.
+    """
+    free = model.free
+    d0 = float(r @ dx)
+
+    def trial(alpha):
+        Xt = X.copy()
+        Xt.reshape(-1)[free] += alpha * dx
+        st = model.element_state(Xt, state.h)
+        if (st.status == NOT_CONVERGED).any():
+            return None
+        rt = _residual(model, st, p)
+        if not np.all(np.isfinite(rt)):
+            return None
+        return Xt, st, rt
+
+    if not d0 < 0.0:
+        alpha = 1.0
+        for _ in range(40):
+            t = trial(alpha)
+            if t is not None and np.linalg.norm(t[2]) <= (1.0 - 1e-4 * alpha) * rn:
+                return (alpha, *t)
+            alpha *= 0.5
+        return None
+    lo, d_lo = 0.0, d0
+    hi, d_hi = None, None
+    alpha = 1.0
+    for _ in range(40):
+        t = trial(alpha)
+        if t is None:
+            hi, d_hi = alpha, None
+            alpha = 0.5 * (lo + alpha)
+            continue
+        d = float(t[2] @ dx)
+        if abs(d) <= 0.5 * abs(d0) or (d < 0.0 and alpha == 1.0):
+            return (alpha, *t)
+        if d < 0.0:
+            lo, d_lo = alpha, d
+        else:
+            hi, d_hi = alpha, d
+        if d_hi is None:
+            alpha = 0.5 * (lo + hi)
+            continue
+        # secant on the slope, kept inside the middle 80 % of the bracket
+        a = lo - d_lo * (hi - lo) / (d_hi - d_lo)
+        alpha = min(max(a, lo + 0.1 * (hi - lo)), hi - 0.1 * (hi - lo))
+    return None
