@@ -39,8 +39,13 @@ def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) 
     n_modes = min(int(n_modes), nf)
     if n_modes < 1:
         raise ConvergenceError("modal step: the model has no free degree of freedom")
-    if nf <= DENSE_LIMIT:
-        lam, vec = sla.eigh(k.toarray(), m.toarray(), subset_by_index=[0, n_modes - 1])
+    if nf <= DENSE_LIMIT or n_modes >= nf - 1:  # ARPACK needs n_modes < nf - 1
+        kd, md = k.toarray(), m.toarray()
+        try:
+            lam, vec = sla.eigh(kd, md, subset_by_index=[0, n_modes - 1])
+        except np.linalg.LinAlgError:  # M singular: massless dofs (a cable of zero mass)
+            lam, vec = _reciprocal(kd, md, n_modes)
+            n_modes = lam.size
         solver = "dense"
     else:
         try:
@@ -66,13 +71,30 @@ def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) 
     return ModalSolution(freq, shapes, plane, symmetry, solver)
 
 
+def _reciprocal(k: np.ndarray, m: np.ndarray, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest modes when M is only semi-definite: M φ = μ K φ with μ = 1/ω² (K must be positive
+    definite, as it is about a stable state). Massless dofs give μ = 0 (infinite frequency) and
+    are left out, so fewer than n_modes modes may come back."""
+    try:
+        mu, vec = sla.eigh(m, k)
+    except np.linalg.LinAlgError as exc:
+        raise ConvergenceError(
+            "modal step: the mass matrix is singular and the tangent stiffness is not positive "
+            "definite about this state; the static state is not stable") from exc
+    finite = np.flatnonzero(mu > 1e-12 * max(mu.max(), 0.0))
+    if finite.size == 0:
+        raise ConvergenceError("modal step: the model has no mass on its free dofs")
+    sel = finite[np.argsort(-mu[finite])][:n_modes]
+    return 1.0 / mu[sel], vec[:, sel]
+
+
 def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str], list[str]]:
     """Label the modes of a single-span cable: in-plane/out-of-plane, symmetric/antisymmetric.
 
     The plane is the vertical plane through the chord; a mode is out-of-plane when most of its
-    mass-weighted motion is normal to it. Symmetry is read from the mirror image about midspan
-    (node k <-> node n-k along the cable). Scenes with several cables, or a vertical chord, are
-    labelled "unclassified".
+    nodal motion (sum of squares over the nodes) is normal to it. Symmetry is read from the
+    mirror image about midspan (node k <-> node n-k along the cable). Scenes with several
+    cables, or a vertical chord, are labelled "unclassified".
     """
     mesh = model.mesh
     n = shapes.shape[0]
