@@ -513,6 +513,65 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, tol, max_iter,
                         dout[e, k, r, c] += sgn * mt[r, c] / (2.0 * delta)
 
 
+@njit(cache=True)
+def _dynamic_forces(edofs, h, load_total, wl0, me, use_m, ce, use_c, kmat, dm, use_dm, alpha,
+                    beta, vel, acc, out):
+    """out (n_dof,) = Σ_e [r_e + M_e a_e + C_e v_e + g_e] with Rayleigh and Lagrangian terms.
+
+    r_e: resisting forces (§4); C_e: material damping, or alpha M_e + beta [[K,-K],[-K,K]];
+    g_e = Ṁ_e v_e - ∂T/∂u (velocity terms of Lagrange's equations, dm = ∂M_e/∂c_k).
+    """
+    out[:] = 0.0
+    fe = np.empty(6)
+    ve = np.empty(6)
+    ae = np.empty(6)
+    qv = np.empty(6)
+    for e in range(edofs.shape[0]):
+        for i in range(6):
+            ve[i] = vel[edofs[e, i]]
+            ae[i] = acc[edofs[e, i]]
+        for i in range(3):
+            fe[i] = -h[e, i]
+            fe[3 + i] = h[e, i] - load_total[e, i]
+        fe[5] += wl0[e]
+        if use_m:
+            for i in range(6):
+                sm = 0.0
+                for j in range(6):
+                    sm += me[e, i, j] * (ae[j] + alpha * ve[j])
+                fe[i] += sm
+        if use_c:
+            for i in range(6):
+                sm = 0.0
+                for j in range(6):
+                    sm += ce[e, i, j] * ve[j]
+                fe[i] += sm
+        if beta != 0.0:
+            for i in range(3):
+                kd = 0.0
+                for j in range(3):
+                    kd += kmat[e, i, j] * (ve[j] - ve[3 + j])
+                fe[i] += beta * kd
+                fe[3 + i] -= beta * kd
+        if use_dm:
+            for k in range(3):
+                cdot = ve[3 + k] - ve[k]
+                half = 0.0
+                for i in range(6):
+                    sm = 0.0
+                    for j in range(6):
+                        sm += dm[e, k, i, j] * ve[j]
+                    qv[i] = sm
+                    half += ve[i] * sm
+                half *= 0.5
+                for i in range(6):
+                    fe[i] += cdot * qv[i]
+                fe[k] += half
+                fe[3 + k] -= half
+        for i in range(6):
+            out[edofs[e, i]] += fe[i]
+
+
 def _sym_from_upper(f6: np.ndarray) -> np.ndarray:
     """(..., 6) upper triangles -> (..., 3, 3) symmetric matrices."""
     out = np.empty(f6.shape[:-1] + (3, 3))

@@ -53,6 +53,9 @@ class TimeFunction:
 
     def evaluate(self, t) -> tuple:
         """Return ``(f, df/dt, d2f/dt2)`` at time(s) ``t`` in seconds."""
+        if isinstance(t, float | int):  # hot path: one time, called by every residual
+            f, df, d2f = self._evaluate(np.float64(t))
+            return float(f), float(df), float(d2f)
         t_arr = np.asarray(t, dtype=float)
         f, df, d2f = self._evaluate(t_arr)
         return _pack(t_arr, f, df, d2f, scalar=t_arr.ndim == 0)

@@ -50,10 +50,11 @@ from sksundae.ida import IDA
 
 from . import results
 from .assembly import Model
-from .element import NOT_CONVERGED, ElementState
+from .element import NOT_CONVERGED, ElementState, _dynamic_forces
 from .errors import SolverError
 
 INCREMENT_SECONDS = 20.0  # wall time between incremental writes of a long run
+_S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
 
 
 class TransientProblem:
@@ -120,6 +121,9 @@ class TransientProblem:
             self.m_diag = np.repeat(model.loading.node_mass, 3)
             self.c_diag = np.zeros(nd)
         # --- work arrays and state
+        self._wl0 = model.mesh.w * model.mesh.L0
+        self._dummy3 = np.zeros((1, 6, 6))
+        self._dummy4 = np.zeros((1, 3, 6, 6))
         self._cache_t = None
         self._cache_q = None
         self._cache = None
@@ -175,46 +179,33 @@ class TransientProblem:
         return V, A
 
     def dynamic_force(self, t, conf, V, A):
-        """M A + C V + F - P on the full dof set, (n_dof,) N, from element blocks."""
+        """M A + C V + g + F - P on the full dof set, (n_dof,) N (one compiled pass)."""
         m = self.model
         state, me, ce, dm = conf
-        ed = m.edofs
-        a_e = A[ed]  # (n_elem, 6)
-        fe = m.elements.end_forces(state.h).reshape(-1, 6)
-        if me is not None:
-            fe = fe + (me @ a_e[:, :, None])[:, :, 0]
-        if dm is not None:
-            # velocity terms of Lagrange's equations with T = ½ vᵀ M(c) v, c = x_j - x_i:
-            # Ṁ v - ∂T/∂q, Ṁ_e = Σ_k ∂M_e/∂c_k ċ_k; ∂T/∂u_j = -∂T/∂u_i = ½ vᵀ ∂M_e/∂c v
-            v_e = V[ed]
-            cdot = v_e[:, 3:] - v_e[:, :3]  # (n_elem, 3)
-            dmv = dm @ v_e[:, None, :, None]  # (n_elem, 3, 6, 1)
-            fe += np.einsum("ek,eki->ei", cdot, dmv[..., 0])
-            half = 0.5 * np.einsum("ei,eki->ek", v_e, dmv[..., 0])  # (n_elem, 3)
-            fe[:, :3] += half
-            fe[:, 3:] -= half
-        if self.damping is not None:
-            v_e = V[ed]
-            if ce is not None:
-                fe += (ce @ v_e[:, :, None])[:, :, 0]
-            if self.alpha and me is not None:
-                fe += self.alpha * (me @ v_e[:, :, None])[:, :, 0]
-            if self.beta:
-                dv = v_e[:, :3] - v_e[:, 3:]
-                kd = (state.K @ dv[:, :, None])[:, :, 0]
-                fe += self.beta * np.concatenate([kd, -kd], axis=1)
-        out = np.bincount(ed.ravel(), weights=fe.ravel(), minlength=self.n_dof)
+        el = m.elements
+        out = np.empty(self.n_dof)
+        damped = self.damping is not None
+        _dynamic_forces(m.edofs, state.h, el._load_total, self._wl0,
+                        me if me is not None else self._dummy3, me is not None,
+                        ce if ce is not None else self._dummy3, ce is not None, state.K,
+                        dm if dm is not None else self._dummy4, dm is not None,
+                        self.alpha if damped else 0.0, self.beta if damped else 0.0, V, A, out)
         out += self.m_diag * A - m.nodal_load(t)
-        if self.damping is not None:
+        if damped:
             out += (self.c_diag + self.alpha * self.m_diag) * V
         return out
 
-    def blocks(self, conf, cj):
-        """CSR data (full dofs) of K_t and of cj M + C."""
+    def blocks(self, conf, cj, V=None, A=None):
+        """CSR data (full dofs) of ∂r_v/∂q ≈ K_t and of ∂r_v/∂v + cj ∂r_v/∂v' ≈ cj M + C.
+
+        With the Lagrangian inertia terms (and V, A given) their first-order parts are added:
+        ∂(M a)/∂u = Σ_k (∂M/∂c_k a) S_k and ∂g/∂v = Σ_k ċ_k ∂M/∂c_k + Qᵀ S - Sᵀ Q, with
+        Q_k = ∂M/∂c_k v, S = ∂c/∂u_e = [-I, I] and g = Ṁ v - ∂T/∂q. The derivatives of ∂M/∂c
+        themselves are left out.
+        """
         m = self.model
-        state, me, ce, _ = conf
+        state, me, ce, dm = conf
         k6 = state.stiffness6
-        kdata = m.pattern.assemble(k6)
         vv = np.zeros_like(k6)
         if me is not None:
             vv += (cj + self.alpha) * me
@@ -222,8 +213,18 @@ class TransientProblem:
             vv += ce
         if self.beta:
             vv += self.beta * k6
+        if dm is not None and V is not None:
+            ed = m.edofs
+            v_e = V[ed]
+            a_e = A[ed]
+            cdot = v_e[:, 3:] - v_e[:, :3]
+            qv = (dm @ v_e[:, None, :, None])[..., 0]  # (n_elem, 3, 6)
+            qa = (dm @ a_e[:, None, :, None])[..., 0]
+            vv += np.einsum("ek,ekij->eij", cdot, dm)
+            vv += np.einsum("eki,kj->eij", qv, _S) - np.einsum("ki,ekj->eij", _S, qv)
+            k6 = k6 + np.einsum("eki,kj->eij", qa, _S)
         diag = (cj + self.alpha) * self.m_diag + self.c_diag
-        return kdata, m.pattern.assemble(vv, diag)
+        return m.pattern.assemble(k6), m.pattern.assemble(vv, diag)
 
     def mass_data(self, conf) -> np.ndarray:
         """CSR data (full dofs) of M(q)."""
@@ -250,18 +251,21 @@ class TransientProblem:
             self.n_rejected += 1
             res[:] = np.nan
 
-    def _jac_parts(self, t, y, cj):
+    def _jac_parts(self, t, y, yp, cj):
         conf = self.configuration(t, y[0::2])
         if conf is None:
             return None
-        kdata, vdata = self.blocks(conf, cj)
+        V = A = None
+        if conf[3] is not None:
+            V, A = self.full_vectors(t, y[1::2], yp[1::2])
+        kdata, vdata = self.blocks(conf, cj, V, A)
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
     def jac_dense(self, t, y, yp, res, cj, JJ):
         """Iteration matrix into the full (2n, 2n) array (dense and band solvers)."""
         self.n_jac += 1
-        parts = self._jac_parts(t, y, cj)
+        parts = self._jac_parts(t, y, yp, cj)
         JJ[:, :] = 0.0
         idx = np.arange(self.n)
         JJ[2 * idx, 2 * idx] = cj
@@ -276,7 +280,7 @@ class TransientProblem:
     def jac_sparse(self, t, y, yp, res, cj, JJ):
         """Iteration matrix as the CSC data array of ``j_pattern`` (sparse solver)."""
         self.n_jac += 1
-        parts = self._jac_parts(t, y, cj)
+        parts = self._jac_parts(t, y, yp, cj)
         data = np.zeros(self.j_nnz)
         data[self.jmap_qq] = cj
         data[self.jmap_qv] = -1.0
