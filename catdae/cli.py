@@ -57,8 +57,12 @@ def main(argv: list[str] | None = None) -> int:
 
             return study_main([args.case, *args.rest])
     except CaseError as exc:
-        print(f"catdae: invalid case\n{exc}", file=sys.stderr)
+        sep = ": " if len(exc.problems) == 1 else "\n"
+        print(f"catdae: invalid case{sep}{exc}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        print(f"catdae: cannot write the results: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("catdae: interrupted", file=sys.stderr)
         return 130
@@ -83,9 +87,14 @@ def _run(args) -> int:
     path = Path(args.case) if args.case else default_case_path()
     case = load_case(path)
     out = Path(args.output) if args.output else Path(f"{path.stem}.nc")
+    if not out.parent.is_dir():
+        print(f"catdae: cannot write {out}: no directory {out.parent}", file=sys.stderr)
+        return 2
     try:
         tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
                    elements=args.elements)
+    except CaseError:
+        raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:
         where = getattr(exc, "output_path", None)
         print(f"catdae: {path}: {exc}", file=sys.stderr)
