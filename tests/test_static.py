@@ -10,12 +10,14 @@ References, none of which share code with catdae:
 - node equilibrium of every free node, and global force and moment balance, evaluated from the
   reported positions with element tensions re-solved by that quadrature;
 - symmetry: mirrored scenes and cables with swapped ends.
+
+The scene of ``cases/three_cables_shared_node.toml`` gets the same equilibrium check in
+``tests/test_cases.py``.
 """
 
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,7 +29,6 @@ from scipy.optimize import root
 import catdae
 from catdae.case import case_from_dict
 
-CASES = Path(__file__).resolve().parent.parent / "cases"
 G = 9.81
 EZ = np.array([0.0, 0.0, 1.0])
 
@@ -357,12 +358,6 @@ def check_equilibrium(case, ds):
     assert ds.attrs["residual_norm"] <= 1e-9 * tmax
     assert ds.attrs["status"] == "completed"
     return tmax
-
-
-def test_three_cable_scene_is_in_equilibrium():
-    case = catdae.load_case(CASES / "three_cables_shared_node.toml")
-    ds = catdae.run(case)["equilibrium"].to_dataset()
-    check_equilibrium(case, ds)
 
 
 def test_cable_net_is_in_equilibrium():

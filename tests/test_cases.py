@@ -1,0 +1,155 @@
+"""Every case file in ``cases/`` loads and runs, with numbers checked against independent
+references where they exist.
+
+Transient steps are shortened to ``T_TEST`` seconds to keep the suite fast (the full runs are the
+examples' job). References: Irvine's elastic catenary (``tests/reference.py``), the elastic cable
+with point loads solved by quadrature in ``tests/test_static.py``, global force and moment
+balance, and the prescribed support motion itself.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from reference import irvine_catenary
+from test_static import cable_position, check_equilibrium, solve_cable
+
+import catdae
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+CASE_FILES = sorted(CASES.glob("*.toml"))
+T_TEST = 0.1  # s, length of every transient step in these tests
+
+
+def shortened(case):
+    steps = tuple(
+        dataclasses.replace(s, duration=min(s.duration, T_TEST),
+                            output_interval=min(s.output_interval, T_TEST / 5))
+        if s.kind == "transient" else s
+        for s in case.steps
+    )
+    return dataclasses.replace(case, steps=steps)
+
+
+_RUNS: dict[str, tuple] = {}
+
+
+def run_case(name: str):
+    """(case, tree) of a case file, run once per test session."""
+    if name not in _RUNS:
+        case = catdae.load_case(CASES / name)
+        _RUNS[name] = case, catdae.run(shortened(case))
+    return _RUNS[name]
+
+
+def test_there_are_cases():
+    assert len(CASE_FILES) >= 5
+
+
+@pytest.mark.parametrize("path", CASE_FILES, ids=lambda p: p.stem)
+def test_every_case_loads_and_runs(path):
+    case, tree = run_case(path.name)
+    assert tree.attrs["status"] == "completed"
+    assert list(tree.children) == [s.name for s in case.steps]
+    assert tree.attrs["case_toml"] == path.read_text()
+    for name, node in tree.children.items():
+        ds = node.to_dataset()
+        assert ds.attrs.get("status", "completed") == "completed", name
+        for v in ds.data_vars:
+            values = ds[v].values
+            if values.dtype.kind == "f" and v != "reaction":
+                assert np.isfinite(values).all(), (name, v)
+
+
+# ------------------------------------------------------------------------------------------------
+# Example 1: a taut cable holding a 100 kg mass at midspan
+# ------------------------------------------------------------------------------------------------
+EX1 = dict(span=44.335, L0=44.304, EA=4.696e8, w=20.3 * 9.81, mass=100.0, s=22.152)
+
+
+def test_example1_hanging_mass_against_the_cable_with_a_point_load():
+    _, tree = run_case("example1_free_vibration.toml")
+    ds = tree["hanging"].to_dataset()
+    P = np.array([0.0, 0.0, -EX1["mass"] * 9.81])
+    loads = [(EX1["s"], P)]
+    h = solve_cable([EX1["span"], 0.0, 0.0], EX1["L0"], EX1["EA"], EX1["w"], loads)
+    x_mass = cable_position(h, EX1["s"], EX1["EA"], EX1["w"], loads)
+    # the reference, for the record: H = 346.0 kN (341.6 kN without the mass), the mass
+    # 0.1727 m below the chord; by symmetry each support carries half of all the weight
+    assert h[0] == pytest.approx(3.4602e5, rel=1e-4)
+    assert -x_mass[2] == pytest.approx(0.17273, rel=1e-4)
+    assert -h[2] == pytest.approx(0.5 * (EX1["w"] * EX1["L0"] - P[2]), rel=1e-12)
+    assert x_mass[0] == pytest.approx(0.5 * EX1["span"], rel=1e-12)
+    # taut: H ~ EA strain, conditioned by EA/H ~ 1.4e3, hence 1e-9
+    assert float(ds.horizontal_tension[0]) == pytest.approx(h[0], rel=1e-9)
+    np.testing.assert_allclose(ds.position.sel(node="main.7").values, x_mass, atol=1e-12)
+    # the deepest point of a level span under a central mass is the mass: the sag is exact
+    assert float(ds.sag[0]) == pytest.approx(-x_mass[2], rel=1e-9)
+    np.testing.assert_allclose(-ds.reaction.sel(node="A").values, h, rtol=1e-9)
+
+
+def test_example1_at_rest_is_the_closed_form_catenary():
+    _, tree = run_case("example1_free_vibration.toml")
+    ds = tree["at_rest"].to_dataset()
+    ref = irvine_catenary(EX1["span"], 0.0, EX1["L0"], EX1["EA"], EX1["w"])
+    assert float(ds.horizontal_tension[0]) == pytest.approx(ref["H"], rel=1e-9)
+    assert float(ds.sag[0]) == pytest.approx(ref["sag"], rel=1e-9)
+    np.testing.assert_allclose(ds.cable_end_tension.values[0], [ref["T_i"], ref["T_j"]],
+                               rtol=1e-9)
+    # the released mass takes its 981 N and about 3 kN of tension away
+    hang = tree["hanging"].to_dataset()
+    dz = hang.reaction.sel(node="A", axis="z") - ds.reaction.sel(node="A", axis="z")
+    assert float(dz) == pytest.approx(0.5 * EX1["mass"] * 9.81, rel=1e-9)
+
+
+# ------------------------------------------------------------------------------------------------
+# Example 2: the support moves as prescribed
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name, a", [("example2_support_motion_gentle.toml", 0.03),
+                                     ("example2_support_motion_violent.toml", 3.0)])
+def test_example2_static_and_support_motion(name, a):
+    _, tree = run_case(name)
+    st = tree["initial"].to_dataset()
+    ref = irvine_catenary(10.0, 0.0, 15.0, 3.4e7, 5.0 * 9.81)
+    assert float(st.horizontal_tension[0]) == pytest.approx(ref["H"], rel=1e-9)
+    assert float(st.sag[0]) == pytest.approx(ref["sag"], rel=1e-9)  # 10 elements: node at midspan
+    tr = tree["excitation"].to_dataset()
+    t = tr.time.values
+    A = tr.position.sel(node="A").values
+    np.testing.assert_allclose(A[:, 0], 0.0, atol=1e-12)
+    np.testing.assert_allclose(A[:, 1], a * (1.0 - np.cos(math.pi * t)), atol=1e-12 * a)
+    np.testing.assert_allclose(A[:, 2], a * np.sin(math.pi * t), atol=1e-12 * a)
+    np.testing.assert_allclose(tr.position.sel(node="B").values, [[10.0, 0.0, 0.0]] * t.size,
+                               atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------------
+# The format example: distributed wind, a mass, a gust ramping from zero, a moving support
+# ------------------------------------------------------------------------------------------------
+def test_format_example_static_force_balance():
+    case, tree = run_case("format_example.toml")
+    ds = tree["hanging"].to_dataset()
+    L0 = 44.304
+    R = ds.reaction.sel(node=["A", "B"]).values.sum(axis=0)
+    # the gust ramps from 0 at t = 0; the wind is 30 N/m along y; weight 199.14 N/m (given)
+    expected = np.array([0.0, -30.0 * L0, 199.14 * L0 + 100.0 * 9.81])
+    np.testing.assert_allclose(R, expected, rtol=0, atol=1e-9 * float(ds.tension.max()))
+    # the wind blows the cable out of its plane, along +y
+    assert float(ds.position.sel(node="main.7", axis="y")) > 0.0
+    np.testing.assert_allclose(ds.position.sel(node="A").values, 0.0, atol=1e-15)
+
+
+# ------------------------------------------------------------------------------------------------
+# Three cables sharing a free node: global force and moment balance, node equilibrium
+# ------------------------------------------------------------------------------------------------
+def test_three_cables_equilibrium():
+    case, tree = run_case("three_cables_shared_node.toml")
+    ds = tree["equilibrium"].to_dataset()
+    tmax = check_equilibrium(case, ds)
+    assert 5e3 < tmax < 1e4
+    # the payload hangs below where the case put it
+    assert float(ds.displacement.sel(node="C", axis="z")) < 0.0
