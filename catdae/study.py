@@ -15,9 +15,11 @@ The pipeline, in order:
    study step only. The run's key is a hash of that configured case.
 3. execute: every run not already in the store is an independent task (:func:`execute`, a
    picklable Case in, a small Dataset out). By default the tasks run on a
-   ``distributed.LocalCluster`` of 2 single-threaded worker processes bound to 127.0.0.1; a
-   scheduler address sends the same tasks to an existing cluster; ``"synchronous"`` runs them
-   here, one after the other.
+   ``distributed.LocalCluster`` of 2 single-threaded worker processes bound to 127.0.0.1 (a
+   script that starts one needs the ``if __name__ == "__main__":`` guard, as for any
+   multiprocessing); a scheduler address or a ``distributed.Client`` sends the same tasks to an
+   existing cluster; ``"synchronous"`` runs them here, one after the other, and lets any
+   unexpected exception through (for debugging).
 4. store: the client writes each finished run to ``<store>/<key>.nc`` as it arrives, so a study
    that crashed or lost a worker resumes where it stopped: a rerun skips stored runs.
 5. errors, against the reference, in the client; then the Dataset.
@@ -797,10 +799,11 @@ def _line_dim(ds: xr.Dataset) -> str:
     return "elements"
 
 
-def plot_work_precision(ds: xr.Dataset, path: str | os.PathLike):
+def plot_work_precision(ds: xr.Dataset, path: str | os.PathLike | None = None):
     """Error against wall time and against residual evaluations (log-log), one line per family
-    of settings, along the first swept of rtol, atol, elements. Writes a PNG; returns the
-    matplotlib Figure (no pyplot: backend-independent, Agg canvas)."""
+    of settings, along the first swept of rtol, atol, elements. Returns the matplotlib Figure,
+    drawn on an Agg canvas without pyplot (so the caller's backend is left alone); with
+    ``path``, also writes it as PNG."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -826,14 +829,16 @@ def plot_work_precision(ds: xr.Dataset, path: str | os.PathLike):
         ax.grid(True, which="both", alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)
-    fig.savefig(path, dpi=110)
+    if path is not None:
+        fig.savefig(path, dpi=110)
     return fig
 
 
-def plot_convergence(ds: xr.Dataset, path: str | os.PathLike):
+def plot_convergence(ds: xr.Dataset, path: str | os.PathLike | None = None):
     """Error against element count (log-log), one line per family of the other swept settings,
-    the fitted order p (error ~ n^-p) in the legend. Writes a PNG and returns the Figure; None
-    (and no file) when fewer than two element counts were run."""
+    the fitted order p (error ~ n^-p) in the legend. Returns the Figure (Agg canvas, no
+    pyplot) and with ``path`` writes it as PNG; None (and no file) with fewer than two element
+    counts."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -854,7 +859,8 @@ def plot_convergence(ds: xr.Dataset, path: str | os.PathLike):
     ax.set_title(f"{ds.attrs.get('case_name', '')}: {ds.attrs.get('response', '')}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
-    fig.savefig(path, dpi=110)
+    if path is not None:
+        fig.savefig(path, dpi=110)
     return fig
 
 
