@@ -476,13 +476,15 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         ref_case = None if given_ref else configure(case, st.name, ref_settings, duration)
     except CaseError as exc:
         raise StudyError(f"a setting of the study makes the case invalid:\n{exc}") from None
+    _MemoryProbe(memory)  # reject an unknown method before anything runs
     keys = [run_key(c, st.name, memory) for c in run_cases]
+    ref_data = _given_reference(reference, st, case) if given_ref else None
     if st.kind == "transient":
+        given_points = set(ref_data.point.values) if given_ref else None
         target = _transient_target(case, run_cases + ([ref_case] if ref_case else []), response,
-                                   grid)
+                                   grid, given_points)
     else:
         target = _modal_target(st, response)
-    ref_data = _given_reference(reference, st, case) if given_ref else None
     ref_key = None if given_ref else run_key(ref_case, st.name, memory)
 
     store_dir = Path(store) if store is not None else None
@@ -525,8 +527,12 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
     return out
 
 
-def _transient_target(case: Case, run_cases: list[Case], response, grid) -> str | list[str]:
+def _transient_target(case: Case, run_cases: list[Case], response, grid,
+                      given_points: set[str] | None) -> str | list[str]:
+    """The response point, or the candidates when the reference is to choose (module doc)."""
     common = _common_points(run_cases)
+    if given_points is not None:
+        common &= given_points
     if response is not None:
         label = _resolve_response(str(response), case)
         if label not in common:
@@ -627,7 +633,7 @@ def _scheduler_name(scheduler, workers: int) -> str:
         return f"distributed.LocalCluster(n_workers={workers}, threads_per_worker=1, processes)"
     if isinstance(scheduler, str):
         return scheduler
-    return str(getattr(scheduler, "scheduler", None) and scheduler.scheduler.address)
+    return str(getattr(getattr(scheduler, "scheduler", None), "address", scheduler))
 
 
 # ---------------------------------------------------------------------------------------------

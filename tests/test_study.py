@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+import catdae
 from catdae import study
 from catdae.case import load_case
 from catdae.study import StudyError, convergence_order, run_study
@@ -113,9 +114,9 @@ def test_modal_frequencies_converge_at_the_order_theory_predicts(tmp_path, mass_
     assert (tmp_path / "conv.png").stat().st_size > 1000
 
 
-# distributed's LocalCluster leaves a "Port ... already in use" or "Creating scratch
-# directories" notice only on busy machines; neither happens on loopback with no dashboard,
-# so no warning filter is needed. Worker processes report through the scheduler, not warnings.
+# No warning filter is needed (pytest runs with warnings as errors): with dashboard_address=None
+# no dashboard port is claimed, so distributed's "Port 8787 is already in use" UserWarning
+# cannot occur, and the scheduler and worker bind to loopback only.
 def test_a_dask_cluster_gives_the_local_numbers():
     distributed = pytest.importorskip("distributed")
     kw = dict(rtol=[1e-3, 1e-5], atol=[1e-10], elements=[4], duration=0.2)
@@ -159,6 +160,35 @@ def test_a_stored_study_is_not_recomputed(tmp_path, monkeypatch):
     np.testing.assert_array_equal(third.error.values, first.error.values)
 
 
+def test_a_run_lost_on_the_cluster_is_recomputed_on_rerun(tmp_path, monkeypatch):
+    # A worker thread in this process (processes=False) sees the monkeypatched task: the
+    # rtol=1e-4 run fails as a lost worker or a bug would, outside catdae's own errors.
+    distributed = pytest.importorskip("distributed")
+    real = study.execute
+
+    def flaky(case_run, step_name, memory="rss"):
+        if case_run.steps[-1].rtol == 1e-4:
+            raise RuntimeError("worker lost")
+        return real(case_run, step_name, memory)
+
+    kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4], duration=0.1,
+              store=tmp_path / "store")
+    monkeypatch.setattr(study, "execute", flaky)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  protocol="tcp://", host="127.0.0.1",
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        first = run_study(GENTLE, scheduler=client, **kw)
+        status = first.status.squeeze()
+        assert status.sel(rtol=1e-3) == "completed"
+        assert status.sel(rtol=1e-4) == "error: RuntimeError: worker lost"
+        assert np.isnan(first.error.squeeze().sel(rtol=1e-4))
+        monkeypatch.setattr(study, "execute", real)
+        again = run_study(GENTLE, scheduler=client, **kw)
+    assert again.attrs["n_runs_computed"] == 1
+    assert (again.status.values == "completed").all()
+
+
 def test_a_crashed_study_resumes(tmp_path, monkeypatch):
     kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4], duration=0.2,
               scheduler="synchronous", store=tmp_path / "store")
@@ -175,6 +205,19 @@ def test_a_crashed_study_resumes(tmp_path, monkeypatch):
     assert (resumed.status.values == "completed").all()
 
 
+def test_a_given_reference_gives_the_automatic_errors():
+    # the automatic reference, computed outside the study with catdae.run, passed as a tree
+    kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4, 8], duration=0.1,
+              scheduler="synchronous")
+    auto = run_study(GENTLE, **kw)
+    ref_settings = {k: auto.attrs[f"reference_{k}"] for k in study.SETTINGS}
+    ref_case = study.configure(load_case(GENTLE), "excitation", ref_settings, duration=0.1)
+    given = run_study(GENTLE, reference=catdae.run(ref_case), **kw)
+    assert given.attrs["reference"] == "given by the user"
+    assert given.attrs["response"] == auto.attrs["response"]
+    np.testing.assert_allclose(given.error.values, auto.error.values, rtol=1e-12)
+
+
 def test_grids_without_a_common_node_are_rejected():
     # example 2's named nodes are both pinned supports: only mesh nodes can be compared, and
     # meshes of 5 and 8 elements share none.
@@ -187,6 +230,8 @@ def test_grids_without_a_common_node_are_rejected():
         run_study(TAUT, rtol=[1e-3])
     with pytest.raises(StudyError, match="max_order: expected an integer from 1 to 5"):
         run_study(GENTLE, max_order=[7])
+    with pytest.raises(StudyError, match="memory: expected 'rss' or 'tracemalloc'"):
+        run_study(GENTLE, memory="psutil", scheduler="synchronous")
 
 
 def test_response_names(tmp_path):
@@ -208,6 +253,16 @@ def test_command_line(tmp_path, capsys):
     assert (tmp_path / "s-work-precision.png").stat().st_size > 1000
     assert not (tmp_path / "s-convergence.png").exists()  # one element count: no order
     assert "rtol=0.001: completed" in capsys.readouterr().out
+    taut = tmp_path / "taut.toml"
+    taut.write_text(TAUT)
+    modal = tmp_path / "m.nc"
+    code = study.main([str(taut), "--elements", "4", "8", "--reference", "elements=32",
+                       "--scheduler", "synchronous", "--store", str(tmp_path / "mstore"), "-o",
+                       str(modal)])
+    assert code == 0, capsys.readouterr().err
+    ds = xr.load_dataset(modal)
+    assert ds.attrs["reference_elements"] == 32 and ds.sizes["mode"] == 4
+    assert (tmp_path / "m-convergence.png").exists()
     bad = study.main([str(GENTLE), "--elements", "5", "8", "--scheduler", "synchronous",
                       "--store", str(tmp_path / "store"), "-o", str(out)])
     assert bad == 2
