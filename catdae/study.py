@@ -753,8 +753,8 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     }
     variables = {v: xr.Variable(dims, data[v], {"units": u, "long_name": ln})
                  for v, (u, ln) in meta.items()}
-    variables["status"] = xr.Variable(dims, status, {"long_name": "run status ('completed' or "
-                                                     "why it stopped)"})
+    variables["status"] = xr.Variable(dims, status, {"units": "1", "long_name": "run status "
+                                                     "('completed' or why it stopped)"})
     out = xr.Dataset(variables, coords=coords)
     if st.kind == "modal":
         out = out.assign_coords(mode=xr.Variable("mode", np.arange(1, n_modes + 1),

@@ -71,7 +71,7 @@ def test_error_shrinks_as_the_tolerance_tightens():
     for v in ("wall_time", *COUNTS, "peak_memory", "error", "status"):
         assert ds[v].dims == study.SETTINGS
         assert "long_name" in ds[v].attrs
-    for v in ("wall_time", *COUNTS, "peak_memory", "error"):
+    for v in ("wall_time", *COUNTS, "peak_memory", "error", "status"):
         assert ds[v].attrs["units"]
 
 
