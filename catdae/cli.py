@@ -39,13 +39,18 @@ def _parser() -> argparse.ArgumentParser:
                    help="progress bar (default: on a terminal)")
     c = sub.add_parser("check", help="validate a case file and report every problem")
     c.add_argument("case")
-    s = sub.add_parser("study", help="accuracy and cost studies (work-precision)")
-    s.add_argument("case")
+    s = sub.add_parser("study", help="accuracy and cost studies (work-precision)",
+                       add_help=False)  # `catdae study -h` is answered by catdae.study
     s.add_argument("rest", nargs=argparse.REMAINDER)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["study"]:  # its options (and -h) belong to catdae.study
+        from .study import main as study_main
+
+        return study_main(argv[1:])
     args = _parser().parse_args(argv)
     try:
         if args.command == "check":
@@ -55,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "study":
             from .study import main as study_main
 
-            return study_main([args.case, *args.rest])
+            return study_main(list(args.rest))
     except CaseError as exc:
         sep = ": " if len(exc.problems) == 1 else "\n"
         print(f"catdae: invalid case{sep}{exc}", file=sys.stderr)

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import sys
 import time as _time
+import warnings
 
 import numpy as np
 import scipy.linalg as sla
@@ -54,6 +55,8 @@ from .element import NOT_CONVERGED, ElementState, _dynamic_forces
 from .errors import SolverError
 
 INCREMENT_SECONDS = 20.0  # wall time between incremental writes of a long run
+STALL_STEP = 1e-12  # a step shorter than this (relative to t or the output interval) ...
+STALL_COUNT = 200  # ... this many times in a row stops the step as stuck
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
 
 
@@ -393,7 +396,12 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
         options.update(sparsity=prob.j_pattern, jacfn=prob.jac_sparse)
     else:
         options.update(jacfn=prob.jac_dense)
-    solver = IDA(prob.resfn, **options)
+    with warnings.catch_warnings():
+        # sksundae warns that its own sparse approximation is unused when jacfn is given:
+        # that is the intent (the analytic iteration matrix)
+        warnings.filterwarnings("ignore", "Custom sparse Jacobian approximation",
+                                UserWarning)
+        solver = IDA(prob.resfn, **options)
     solver.init_step(t0, y0, yp0)
 
     nn = model.mesh.n_nodes
@@ -444,13 +452,22 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
         record(0, t0, y0, yp0)
         k_done = 1
         t_int = t0
+        stalled = 0
         while k_done < times.size:
             res = solver.step(t_end, method="onestep", tstop=t_end)
             if not res.success:
                 status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
                 break
             n_steps += 1
-            t_int = float(np.atleast_1d(res.t)[-1])
+            t_new = float(np.atleast_1d(res.t)[-1])
+            # IDA's max_num_steps counts per call; in one-step mode guard the step size
+            # ourselves: steps that no longer advance time mean the integration is stuck
+            stalled = stalled + 1 if t_new - t_int <= STALL_STEP * max(abs(t_new), dt_out) else 0
+            t_int = t_new
+            if stalled >= STALL_COUNT:
+                status = (f"step size collapsed at t = {t_int:.6g} s (IDA could not advance; "
+                          f"{prob.n_rejected} trial states rejected)")
+                break
             while k_done < times.size and times[k_done] <= t_int * (1 + 1e-13) + 1e-300:
                 tk = times[k_done]
                 if abs(tk - t_int) <= 1e-13 * max(abs(t_int), 1.0):
