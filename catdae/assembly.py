@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.optimize import minimize_scalar
 
 from .case import Case
 from .element import Elements, ElementState, PointLoads
@@ -371,9 +372,27 @@ class Model:
             c = b - a
             ch = np.hypot(c[0], c[1])
             if ch > 1e-9 * np.linalg.norm(c):
-                frac = (p[:, :2] @ c[:2]) / ch**2
-                sag[ci] = float(np.max(frac * c[2] - p[:, 2]))
+                def dist(pts_rel, c=c, ch=ch):
+                    return (pts_rel[..., :2] @ c[:2]) / ch**2 * c[2] - pts_rel[..., 2]
             else:
-                u = c / np.linalg.norm(c)
-                sag[ci] = float(np.max(np.linalg.norm(p - np.outer(p @ u, u), axis=1)))
+                def dist(pts_rel, c=c):
+                    u = c / np.linalg.norm(c)
+                    return np.linalg.norm(pts_rel - np.multiply.outer(pts_rel @ u, u), axis=-1)
+            d = dist(p)
+            k = int(np.argmax(d))
+            # refine the sampled maximum on the exact curve of its element
+            e = int(els[k // s.shape[1]])
+            j = k % s.shape[1]
+            ds_ = mesh.L0[e] / (s.shape[1] - 1)
+            lo, hi = max(0.0, s[e, j] - ds_), min(mesh.L0[e], s[e, j] + ds_)
+            xi = X[mesh.conn[e, 0]] - a
+
+            def neg(sv, e=e, xi=xi, dist=dist):
+                q = np.zeros((mesh.n_elements, 1))
+                q[e, 0] = sv
+                return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
+
+            best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                                   options={"xatol": 1e-10 * mesh.L0[e]})
+            sag[ci] = max(float(d[k]), -float(best.fun))
         return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag}
