@@ -471,21 +471,27 @@ def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, 
 
 
 @njit(cache=True)
-def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, tol, max_iter, gs, gw, mq,
+def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me, gs, gw, mq,
                          pmptr, pms, pmm, dout):
-    """∂M_e/∂c_k (n, 3, 6, 6) by central differences of the chord c = x_j - x_i.
+    """∂M_e/∂c_k (n, 3, 6, 6) by forward differences of the chord c = x_j - x_i.
 
-    M_e depends on the nodes only through the chord. The step is 1e-4 of |F h|, the chord
-    change that alters the tension by its own size, so it suits taut and slack elements alike.
+    M_e depends on the nodes only through the chord. The step δ is 1e-7 of |F h| (the chord
+    change that alters the tension by its own size), so it suits taut and slack elements
+    alike; the perturbed tension is the linear prediction h + K δ e_k (its error, O(δ²), is
+    below the differencing error), and F, K and M_e are evaluated there exactly.
+    Slack elements (straight-line interpolation, constant M_e) get zero.
     """
     x = np.empty(3)
     g6 = np.empty(6)
+    d = np.empty(3)
     f6 = np.empty(6)
     kk = np.empty((3, 3))
     ht = np.empty(3)
-    ct = np.empty(3)
     mt = np.empty((6, 6))
     for e in range(chord.shape[0]):
+        dout[e, :, :, :] = 0.0
+        if stat[e] != CONVERGED:
+            continue
         fe = fflat[e]
         he = h[e]
         fh0 = fe[0] * he[0] + fe[1] * he[1] + fe[2] * he[2]
@@ -494,23 +500,19 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, tol, max_iter,
         scale = np.sqrt(fh0 * fh0 + fh1 * fh1 + fh2 * fh2)
         if not np.isfinite(scale):
             scale = l0[e]
-        delta = max(1e-4 * min(scale, l0[e]), 1e-12 * l0[e])
-        dout[e, :, :, :] = 0.0
+        delta = max(1e-7 * min(scale, l0[e]), 1e-13 * l0[e])
         for k in range(3):
-            for sgn in (1.0, -1.0):
-                for m in range(3):
-                    ct[m] = chord[e, m]
-                    ht[m] = he[m]
-                ct[k] += sgn * delta
-                _, st = _solve_one(ct, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], ht, True,
-                                   tol, max_iter, f6, kk)
-                if st == NOT_CONVERGED:
-                    continue
-                _mass_one(ht, kk, st == SLACK, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
-                          gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
-                for r in range(6):
-                    for c in range(6):
-                        dout[e, k, r, c] += sgn * mt[r, c] / (2.0 * delta)
+            for m in range(3):
+                ht[m] = he[m] + delta * kmat[e, m, k]
+            ok = _partial(ht[0], ht[1], ht[2], w[e], ea[e], l0[e], ls, lf, ptr[e], ptr[e + 1],
+                          d, f6, True)
+            if not ok or not _inv_sym3(f6, kk):
+                continue
+            _mass_one(ht, kk, False, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], gs[e],
+                      gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
+            for r in range(6):
+                for c in range(6):
+                    dout[e, k, r, c] = (mt[r, c] - me[e, r, c]) / delta
 
 
 @njit(cache=True)
@@ -742,12 +744,13 @@ class Elements:
         self._last_dynamic = (chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter)
         return state, me, (ce if want_c else None)
 
-    def mass_gradient(self, state: ElementState) -> np.ndarray:
-        """∂M_e/∂c_k, (n, 3, 6, 6), about the state of the last ``solve_dynamic`` call."""
+    def mass_gradient(self, state: ElementState, me: np.ndarray) -> np.ndarray:
+        """∂M_e/∂c_k, (n, 3, 6, 6), about the state (and its M_e) of the last solve_dynamic."""
         chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter = self._last_dynamic
         out = np.empty((self.n, 3, 6, 6))
         _mass_gradient_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf,
-                             state.h, f6, tol, max_iter, gs, gw, mq, pmptr, pms, pmm, out)
+                             state.h, f6, state.K, state.status, me, gs, gw, mq, pmptr, pms,
+                             pmm, out)
         return out
 
     def _point_mass_csr(self, point_masses):
