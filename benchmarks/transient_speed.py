@@ -1,0 +1,294 @@
+"""Transient (IDA) speed: work against accuracy, BDF order, linear solver, and mesh size.
+
+Scenes
+- Example 1 (``cases/example1_free_vibration.toml``): the 'release' transient step (14 elements,
+  4 s, Rayleigh damping), after its static step.
+- The 100 m cable: span 100 m, L0 = 102 m, EA = 1e8 N, weight 100 N/m (mass 100/9.81 kg/m),
+  pinned ends; the end A moves vertically as z_A = 0.5 (1 - cos πt) m (a 0.5 m, 0.5 Hz
+  oscillation about 0.5 m that starts from rest: displacement and velocity are zero at t = 0 and
+  the motion is analytic on the whole integration interval). 16 elements, 10 s.
+
+Each tolerance rtol is run with atol = rtol * 1e-2 m (displacements; catdae scales the velocity
+atol by the lowest circular frequency). The error of a run is the largest distance, over the
+output times (every 0.01 s), between the midspan node's position and that of a reference run at
+rtol = 1e-10 (atol 1e-12 m) on the same mesh.
+
+Run apart from the tests:
+
+    python benchmarks/transient_speed.py [--part accuracy|scaling|profile|all] [--quick]
+
+It prints markdown tables (copied into ``benchmarks/transient_speed.md``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import sys
+import time
+import tomllib
+from datetime import datetime
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+import catdae  # noqa: E402
+from catdae.case import case_from_dict  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE1 = ROOT / "cases" / "example1_free_vibration.toml"
+TOLS = (1e-4, 1e-6, 1e-8)
+REF_RTOL = 1e-10
+# simulated seconds per mesh size in the scaling part (the step count grows with the mesh:
+# each run is kept under about a minute)
+DURATIONS = {10: 2.0, 50: 1.0, 200: 0.1, 1000: 0.02, 2000: 0.01}
+
+CABLE_TOML = """
+title = "Benchmark: 100 m cable, one end moving vertically"
+gravity = 9.81
+
+[materials.m]
+EA = 1.0e8
+mass = {mass!r}
+weight = 100.0
+
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [100.0, 0.0, 0.0]
+
+[supports]
+A = "pinned"
+B = "pinned"
+
+[[cables]]
+name = "c"
+ends = ["A", "B"]
+material = "m"
+length = 102.0
+elements = {elements}
+gauss_points = 3
+
+[[support_motions]]
+node = "A"
+z = {{ kind = "cosine", amplitude = -0.5, frequency = 0.5, offset = 0.5 }}
+
+[[steps]]
+kind = "static"
+name = "initial"
+
+[[steps]]
+kind = "transient"
+name = "motion"
+duration = {duration!r}
+output_interval = {output_interval!r}
+rtol = 1e-6
+atol = 1e-8
+"""
+
+
+def cable_dict(elements: int = 16, duration: float = 10.0, output_interval: float = 0.01,
+               **step) -> dict:
+    text = CABLE_TOML.format(mass=100.0 / 9.81, elements=elements, duration=duration,
+                             output_interval=output_interval)
+    d = tomllib.loads(text)
+    d["steps"][1].update(step)
+    return d
+
+
+def example1_dict(**step) -> dict:
+    d = tomllib.loads(EXAMPLE1.read_text())
+    d["steps"] = [s for s in d["steps"] if s["name"] in ("hanging", "release")]
+    d["steps"][1].update(step)
+    return d
+
+
+def run_dict(d: dict) -> tuple:
+    """Run a case dict; return (transient dataset, its step name, whole-run wall time)."""
+    case = case_from_dict(d)
+    name = d["steps"][-1]["name"]
+    t0 = time.perf_counter()
+    tree = catdae.run(case, progress=False)
+    wall = time.perf_counter() - t0
+    return tree[name].ds, tree, wall
+
+
+def tol(rtol: float) -> dict:
+    return {"rtol": rtol, "atol": rtol * 1e-2}
+
+
+def midspan(ds, node: str) -> np.ndarray:
+    return ds.position.sel(node=node).values  # (time, 3)
+
+
+def error(ds, ref, node: str) -> float:
+    a, b = midspan(ds, node), midspan(ref, node)
+    n = min(len(a), len(b))
+    return float(np.max(np.linalg.norm(a[:n] - b[:n], axis=1)))
+
+
+def row(ds, err=None, **extra) -> dict:
+    a = ds.attrs
+    out = {"wall": float(a["wall_time"]), "steps": int(a["n_steps"]),
+           "nres": int(a["n_residual_evaluations"]), "njac": int(a["n_jacobian_evaluations"]),
+           "solver": str(a["linear_solver"]), "bandwidth": int(a["bandwidth"]),
+           "status": str(a["status"]), "duration": float(ds.time.values[-1])}
+    out["us_per_res"] = 1e6 * out["wall"] / max(out["nres"], 1)
+    if err is not None:
+        out["err"] = err
+    out.update(extra)
+    return out
+
+
+def machine() -> str:
+    import numba
+    import scipy
+    import sksundae
+
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    return (f"{platform.platform()}, cpu `{cpu}`, {os.cpu_count()} logical CPUs, 1-min load "
+            f"{load:.2f}; Python {platform.python_version()}, numpy {np.__version__}, scipy "
+            f"{scipy.__version__}, numba {numba.__version__}, scikit-sundae "
+            f"{sksundae.__version__}, catdae {catdae.__version__}; "
+            f"{datetime.now():%Y-%m-%d %H:%M}; OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']}")
+
+
+# --------------------------------------------------------------------------------- part 1
+def accuracy(quick: bool = False) -> dict:
+    out = {}
+    scenes = {
+        "example1": (example1_dict, "main.7", {}),
+        "cable16": (cable_dict, "c.8", {}),
+    }
+    for scene, (make, node, base) in scenes.items():
+        ref, _, _ = run_dict(make(**base, **tol(REF_RTOL)))
+        rows = [dict(row(ref), rtol=REF_RTOL, order=5, requested="auto")]
+        print(f"{scene}: reference {rows[0]['wall']:.2f} s, {rows[0]['steps']} steps",
+              file=sys.stderr)
+        variants = [("auto", 5), ("auto", 2)]
+        if scene == "cable16":
+            variants += [("band", 5), ("sparse", 5), ("dense", 5)]
+        for rtol in TOLS[:2] if quick else TOLS:
+            for solver, order in variants:
+                ds, _, _ = run_dict(make(**base, **tol(rtol), max_order=order,
+                                         linear_solver=solver))
+                r = row(ds, error(ds, ref, node), rtol=rtol, order=order, requested=solver)
+                rows.append(r)
+                print(f"  rtol {rtol:g} order {order} {solver}: {r['wall']:.2f} s, "
+                      f"{r['steps']} steps, err {r['err']:.2e}", file=sys.stderr)
+        out[scene] = rows
+    return out
+
+
+# --------------------------------------------------------------------------------- part 2
+def scaling(quick: bool = False) -> list:
+    rows = []
+    sizes = (10, 50, 200, 1000, 2000)
+    for ne in sizes[:3] if quick else sizes:
+        duration = DURATIONS[ne]
+        used = None
+        for solver in ("auto", "band", "sparse"):
+            if solver == used:  # 'auto' already ran it
+                continue
+            d = cable_dict(ne, duration, min(0.01, duration / 10), **tol(1e-6),
+                           linear_solver=solver)
+            ds, _, _ = run_dict(d)
+            used = used or str(ds.attrs["linear_solver"])
+            r = row(ds, ne=ne, requested=solver)
+            r["per_sim_s"] = r["wall"] / r["duration"]
+            rows.append(r)
+            print(f"  {ne} elements {solver} ({r['solver']}): {r['wall']:.2f} s for "
+                  f"{r['duration']} s, {r['steps']} steps, {r['us_per_res']:.0f} us/res",
+                  file=sys.stderr)
+    return rows
+
+
+# --------------------------------------------------------------------------------- profile
+def profile(scene: str = "cable16", n: int = 30) -> str:
+    d = cable_dict(16, 10.0, **tol(1e-6)) if scene == "cable16" else \
+        cable_dict(1000, 0.2, 0.01, **tol(1e-6))
+    case = case_from_dict(d)
+    catdae.run(case_from_dict(cable_dict(16, 0.05)), progress=False)  # warm the jit caches
+    pr = cProfile.Profile()
+    pr.enable()
+    catdae.run(case, progress=False)
+    pr.disable()
+    s = io.StringIO()
+    pstats.Stats(pr, stream=s).sort_stats("tottime").print_stats(n)
+    return s.getvalue()
+
+
+# --------------------------------------------------------------------------------- tables
+def fmt_accuracy(res: dict) -> str:
+    lines = []
+    for scene, rows in res.items():
+        lines += [f"\n{scene}\n",
+                  "| rtol | max_order | solver (requested -> used) | wall s | steps | residuals "
+                  "| Jacobians | µs/residual | midspan error m |",
+                  "|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
+        for r in rows:
+            err = f"{r['err']:.2e}" if "err" in r else "reference"
+            lines.append(f"| {r['rtol']:.0e} | {r['order']} | {r['requested']} -> {r['solver']} "
+                         f"| {r['wall']:.2f} | {r['steps']} | {r['nres']} | {r['njac']} | "
+                         f"{r['us_per_res']:.0f} | {err} |")
+    return "\n".join(lines)
+
+
+def fmt_scaling(rows: list) -> str:
+    lines = ["| elements | unknowns | simulated s | solver (requested -> used) | wall s | "
+             "wall s per simulated s | steps | residuals | Jacobians | ms/residual | "
+             "ms/residual per element |",
+             "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        n2 = 2 * 3 * (r["ne"] - 1)
+        lines.append(f"| {r['ne']} | {n2} | {r['duration']:g} | {r['requested']} -> "
+                     f"{r['solver']} | {r['wall']:.2f} | {r['per_sim_s']:.2f} | {r['steps']} | "
+                     f"{r['nres']} | {r['njac']} | {r['us_per_res'] / 1e3:.2f} | "
+                     f"{r['us_per_res'] / 1e3 / r['ne']:.4f} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--part", default="all",
+                    choices=["accuracy", "scaling", "profile", "profile1000", "all"])
+    ap.add_argument("--quick", action="store_true", help="fewer runs (a smoke test)")
+    ap.add_argument("--json", help="also write the raw numbers here")
+    args = ap.parse_args(argv)
+    print(f"Machine: {machine()}\n")
+    raw = {}
+    # compile the kernels before timing anything
+    catdae.run(case_from_dict(cable_dict(16, 0.05)), progress=False)
+    if args.part in ("accuracy", "all"):
+        raw["accuracy"] = accuracy(args.quick)
+        print(fmt_accuracy(raw["accuracy"]))
+    if args.part in ("scaling", "all"):
+        raw["scaling"] = scaling(args.quick)
+        print("\n" + fmt_scaling(raw["scaling"]))
+    if args.part in ("profile", "all"):
+        print("\ncProfile, 16-element cable, 10 s, rtol 1e-6 (tottime):\n")
+        print(profile("cable16"))
+    if args.part == "profile1000":
+        print("\ncProfile, 1000-element cable, 0.2 s, rtol 1e-6 (tottime):\n")
+        print(profile("cable1000"))
+    print(f"\nMachine after: 1-min load {os.getloadavg()[0]:.2f}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(raw, indent=1))
+
+
+if __name__ == "__main__":
+    main()
