@@ -64,6 +64,12 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         model = Model(case, mesh, removed, mass_model=step.mass_model)
         try:
             ds = _run_step(step, model, state, writer, progress)
+        except KeyboardInterrupt:
+            # keep what the finished steps computed; the interrupt itself goes on
+            tree = results.make_tree(case, groups,
+                                     status=f"interrupted in step '{step.name}'")
+            writer.write_failed(tree)
+            raise
         except CatdaeError as exc:
             ds_partial = getattr(exc, "partial", None)
             if isinstance(ds_partial, xr.Dataset):

@@ -68,6 +68,9 @@ class TransientProblem:
         self.step = step
         self.n_dof = model.n_dof
         free = model.free
+        if free.size == 0:
+            raise SolverError("transient step: the model has no free degree of freedom "
+                              "(every node is supported)", termination="no free dof")
         # --- ordering: reverse Cuthill-McKee on the free-free stiffness graph
         pat = model.pattern
         full = sp.csr_matrix((np.ones(pat.nnz), pat.indices, pat.indptr),

@@ -463,12 +463,6 @@ def test_modal_step_without_free_dofs_is_a_clean_failure(tmp_path, capsys):
     assert_sound(tree)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "transient step on a scene with no free dof (one element between two pinned supports, "
-    "`catdae run` on a static + transient case): ValueError 'zero-size array to reduction "
-    "operation maximum which has no identity' from scipy reverse_cuthill_mckee in "
-    "TransientProblem.__init__ escapes as a traceback; expected a completed step (the state "
-    "is fully prescribed: constant tension) or a clean CatdaeError with exit code 1"))
 def test_transient_step_without_free_dofs(tmp_path, capsys):
     tree = _no_free_dof_run(tmp_path, capsys, transient(0.1, 0.01))
     if tree is not None:
@@ -676,11 +670,6 @@ def test_interrupted_transient_in_process_keeps_results(tmp_path, monkeypatch, c
     assert not (tmp_path / "long.partial.nc").exists()
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "KeyboardInterrupt during a modal step that follows a completed static step (catdae run "
-    "CASE -o OUT): the CLI exits 130 but writes nothing (no OUT, no OUT stem .failed.nc): the "
-    "completed static results are lost; expected a readable file whose status says "
-    "'interrupted', as for an interrupted transient step"))
 def test_interrupted_modal_step_keeps_the_static_results(tmp_path, monkeypatch, capsys):
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
