@@ -58,6 +58,7 @@ INCREMENT_SECONDS = 20.0  # wall time between incremental writes of a long run
 STALL_STEP = 1e-12  # a step shorter than this (relative to t or the output interval) ...
 STALL_COUNT = 200  # ... this many times in a row stops the step as stuck
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
+_GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
 
 
 class TransientProblem:
@@ -339,7 +340,7 @@ def _potential(model: Model, X: np.ndarray, state: ElementState, t: float):
     """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J."""
     mesh = model.mesh
     el = model.elements
-    xi, wi = np.polynomial.legendre.leggauss(8)
+    xi, wi = _GAUSS8
     s = 0.5 * (xi + 1.0)[None, :] * mesh.L0[:, None]  # (n_elem, 8)
     wq = 0.5 * wi[None, :] * mesh.L0[:, None]
     tens = el.tension(state.h, s)  # (n_elem, 8)
@@ -368,7 +369,9 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
     band = 4 * problem.bandwidth + 3
     if n2 <= 24:
         return "dense"
-    if band <= max(32, n2 // 4):
+    # measured (benchmarks/transient_speed.md): band is fastest up to ~50 elements; from ~200
+    # elements sparse is as fast or faster, and sksundae's band matrix is stored as n x n
+    if band <= max(32, n2 // 4) and n2 <= 800:
         return "band"
     return "sparse"
 
@@ -461,8 +464,9 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             if not res.success:
                 status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
                 break
-            n_steps += 1
             t_new = float(np.atleast_1d(res.t)[-1])
+            if t_new > t_int:
+                n_steps += 1
             # IDA's max_num_steps counts per call; in one-step mode guard the step size
             # ourselves: steps that no longer advance time mean the integration is stuck
             stalled = stalled + 1 if t_new - t_int <= STALL_STEP * max(abs(t_new), dt_out) else 0
