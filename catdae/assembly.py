@@ -232,10 +232,6 @@ class Model:
     def has_internal_loads(self) -> bool:
         return self.loading.internal_s.size > 0
 
-    @property
-    def has_timed_loads(self) -> bool:
-        return bool(self.loading.node_timed or self.loading.internal_timed)
-
     # -------------------------------------------------------------------------- element state
     def chords(self, X: np.ndarray) -> np.ndarray:
         """(n_elem, 3) chords x_j - x_i from node positions X (n_nodes, 3)."""
@@ -320,17 +316,6 @@ class Model:
 
     def mass(self, state: ElementState) -> sp.csr_matrix:
         return self.pattern.matrix(self.mass_data(state))
-
-    def material_damping_data(self, state: ElementState) -> np.ndarray:
-        """CSR data of C = Σ_g c L0 w_g NᵀN (material damping, §7)."""
-        if self.mass_model == "lumped":
-            mesh = self.mesh
-            node = np.zeros(mesh.n_nodes)
-            half = 0.5 * mesh.c * mesh.L0
-            np.add.at(node, mesh.conn[:, 0], half)
-            np.add.at(node, mesh.conn[:, 1], half)
-            return self.pattern.assemble(None, np.repeat(node, 3))
-        return self.pattern.assemble(self.element_mass(state, self.mesh.c, with_points=False))
 
     # ------------------------------------------------------------------------- reporting
     def reactions(self, state: ElementState, t: float) -> np.ndarray:
