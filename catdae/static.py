@@ -9,9 +9,11 @@ halved, so that hard starts (a large point load on a slack cable) still converge
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .assembly import Model
@@ -88,11 +90,8 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
         if rn <= rtol * tscale:
             return True, X, state, it - 1, rn
         k = model.stiffness(state)[free][:, free].tocsc()
-        try:
-            dx = spla.spsolve(k, -r)
-        except RuntimeError:
-            return False, X, state, it, rn
-        if not np.all(np.isfinite(dx)):
+        dx = _solve(k, -r)
+        if dx is None:
             return False, X, state, it, rn
         step = _line_search(model, X, state, dx, r, rn, p)
         if step is None:
@@ -162,4 +161,24 @@ def _line_search(model: Model, X, state, dx, r, rn, p):
         # secant on the slope, kept inside the middle 80 % of the bracket
         a = lo - d_lo * (hi - lo) / (d_hi - d_lo)
         alpha = min(max(a, lo + 0.1 * (hi - lo)), hi - 0.1 * (hi - lo))
+    return None
+
+
+def _solve(k, rhs):
+    """K dx = rhs; a singular K (a slack element has no lateral stiffness, e.g. a hanging line
+    started folded) is regularised by a small multiple of its largest diagonal, which leaves
+    the directions that have stiffness unchanged to round-off and gives the others a finite
+    step that the line search then judges."""
+    for mu in (0.0, 1e-10, 1e-6):
+        kk = k
+        if mu:
+            kk = (k + mu * abs(k.diagonal()).max() * sp.identity(k.shape[0], format="csc"))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", spla.MatrixRankWarning)
+            try:
+                dx = spla.spsolve(kk.tocsc(), rhs)
+            except (RuntimeError, spla.MatrixRankWarning):
+                continue
+        if np.all(np.isfinite(dx)):
+            return dx
     return None
