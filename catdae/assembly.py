@@ -254,29 +254,14 @@ class Model:
         return self.pattern.matrix(self.stiffness_data(state))
 
     # ------------------------------------------------------------------------------- mass
-    def element_mass(self, state: ElementState, per_length: np.ndarray | None = None,
-                     with_points: bool = True) -> np.ndarray:
-        """Consistent element matrices Σ_g q L0 w_g NᵀN (+ point masses), (n_elem, 6, 6) (§7).
+    def element_mass(self, state: ElementState) -> np.ndarray:
+        """Consistent element matrices Σ_g m L0 w_g NᵀN + point masses, (n_elem, 6, 6) (§7).
 
-        ``per_length`` is the mass per unstrained length (default) or, for material damping,
-        the damping coefficient per length.
+        The compiled quadrature that the transient step also uses (Elements.solve_dynamic).
         """
-        mesh = self.mesh
-        q = mesh.m if per_length is None else per_length
-        nmat = self.elements.interpolation(state, self.gauss_s)  # (n_elem, g, 3, 6)
-        wq = (q * mesh.L0)[:, None] * self.gauss_w  # (n_elem, g)
-        me = np.einsum("eg,egki,egkj->eij", wq, nmat, nmat)
         ld = self.loading
-        if with_points and ld.mass_value.size:
-            e = ld.mass_elem
-            s = np.zeros((mesh.n_elements, 1))
-            # one point at a time keeps shapes regular (point masses are few)
-            for k in range(e.size):
-                s[:] = 0.0
-                s[e[k], 0] = ld.mass_s[k]
-                nk = self.elements.interpolation(state, s)[e[k], 0]  # (3, 6)
-                me[e[k]] += ld.mass_value[k] * nk.T @ nk
-        return me
+        return self.elements.element_masses(state, self.gauss_s, self.gauss_w, self.mesh.m,
+                                            (ld.mass_elem, ld.mass_s, ld.mass_value))
 
     def dynamic_state(self, X: np.ndarray, h0: np.ndarray | None, material_damping: bool):
         """Element state with element mass (and material damping) matrices in one pass.
@@ -293,19 +278,24 @@ class Model:
             me = None
         return state, me, ce
 
-    def lumped_mass_diag(self) -> np.ndarray:
-        """Lumped masses on the dofs: half of each element's mass at each end, (n_dof,) kg."""
+    def lumped_mass_diag(self, per_length: np.ndarray | None = None) -> np.ndarray:
+        """Lumped diagonal on the dofs: half of each element at each end, (n_dof,).
+
+        Default: masses (kg), with point masses split by arc length and nodal masses added.
+        With ``per_length`` (e.g. material damping per length): that quantity alone.
+        """
         mesh = self.mesh
+        q = mesh.m if per_length is None else per_length
         node = np.zeros(mesh.n_nodes)
-        half = 0.5 * mesh.m * mesh.L0
-        np.add.at(node, mesh.conn[:, 0], half)
-        np.add.at(node, mesh.conn[:, 1], half)
+        np.add.at(node, mesh.conn.ravel(), np.repeat(0.5 * q * mesh.L0, 2))
         ld = self.loading
-        if ld.mass_value.size:
-            frac = ld.mass_s / mesh.L0[ld.mass_elem]
-            np.add.at(node, mesh.conn[ld.mass_elem, 0], (1 - frac) * ld.mass_value)
-            np.add.at(node, mesh.conn[ld.mass_elem, 1], frac * ld.mass_value)
-        return np.repeat(node + ld.node_mass, 3)
+        if per_length is None:
+            if ld.mass_value.size:
+                frac = ld.mass_s / mesh.L0[ld.mass_elem]
+                np.add.at(node, mesh.conn[ld.mass_elem, 0], (1 - frac) * ld.mass_value)
+                np.add.at(node, mesh.conn[ld.mass_elem, 1], frac * ld.mass_value)
+            node += ld.node_mass
+        return np.repeat(node, 3)
 
     def mass_data(self, state: ElementState) -> np.ndarray:
         """CSR data of the mass matrix M(q) on the full dof set."""

@@ -471,6 +471,17 @@ def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, 
 
 
 @njit(cache=True)
+def _mass_batch(h, kmat, stat, l0, ea, w, ptr, ls, lf, gs, gw, mq, pmptr, pms, pmm, out):
+    """Consistent element matrices (n, 6, 6) about solved tensions h (§7); see _mass_one."""
+    x = np.empty(3)
+    g6 = np.empty(6)
+    for e in range(h.shape[0]):
+        _mass_one(h[e], kmat[e], stat[e] == SLACK, l0[e], ea[e], w[e], ls, lf, ptr[e],
+                  ptr[e + 1], gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True,
+                  out[e], x, g6)
+
+
+@njit(cache=True)
 def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me, gs, gw, mq,
                          pmptr, pms, pmm, dout):
     """∂M_e/∂c_k (n, 3, 6, 6) by central differences of the chord c = x_j - x_i.
@@ -749,6 +760,22 @@ class Elements:
         state = ElementState(h, _sym_from_upper(f6), kmat, its, stat)
         self._last_dynamic = (chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter)
         return state, me, (ce if want_c else None)
+
+    def element_masses(self, state: ElementState, gauss_s, gauss_w, per_length,
+                       point_masses=None) -> np.ndarray:
+        """Σ_g q L0 w_g NᵀN (+ Σ_p m_p NᵀN at point masses), (n, 6, 6), about a solved state.
+
+        ``per_length`` (n,) is the mass (or damping coefficient) per unstrained length; the
+        same compiled quadrature as :meth:`solve_dynamic`, without solving the elements.
+        """
+        pmptr, pms, pmm = self._point_mass_csr(point_masses)
+        out = np.empty((self.n, 6, 6))
+        _mass_batch(np.ascontiguousarray(state.h, float), np.ascontiguousarray(state.K, float),
+                    np.ascontiguousarray(state.status, np.int64), self.L0, self.EA, self.w,
+                    self._ptr, self._ls, self._lf, np.ascontiguousarray(gauss_s, float),
+                    np.ascontiguousarray(gauss_w, float),
+                    np.ascontiguousarray(per_length, float), pmptr, pms, pmm, out)
+        return out
 
     def mass_gradient(self, state: ElementState, me: np.ndarray) -> np.ndarray:
         """∂M_e/∂c_k, (n, 3, 6, 6), about the state (and its M_e) of the last solve_dynamic."""

@@ -118,12 +118,8 @@ class TransientProblem:
         nd = model.n_dof
         if model.mass_model == "lumped":
             self.m_diag = model.lumped_mass_diag()
-            self.c_diag = np.zeros(nd)
-            if self.material:
-                mesh = model.mesh
-                node = np.zeros(mesh.n_nodes)
-                np.add.at(node, mesh.conn.ravel(), np.repeat(0.5 * mesh.c * mesh.L0, 2))
-                self.c_diag = np.repeat(node, 3)
+            self.c_diag = (model.lumped_mass_diag(model.mesh.c) if self.material
+                           else np.zeros(nd))
         else:
             self.m_diag = np.repeat(model.loading.node_mass, 3)
             self.c_diag = np.zeros(nd)

@@ -405,10 +405,22 @@ def test_mass_matrix_identities(name, mass_model):
         mf = M[np.ix_(model.free, model.free)]
         assert np.linalg.eigvalsh(mf).min() > 0.0, label
         if mass_model == "consistent":
+            # the compiled mass (modal and transient paths) against the quadrature of §7
+            # written out here from N(s) (which test_element checks by finite differences)
             _, me, _ = model.elements.solve_dynamic(
                 model.chords(X), state.h, model.gauss_s, model.gauss_w, mesh.m, None,
                 (model.loading.mass_elem, model.loading.mass_s, model.loading.mass_value))
-            np.testing.assert_allclose(me, model.element_mass(state), rtol=0,
+            nmat = model.elements.interpolation(state, model.gauss_s)  # (n_elem, g, 3, 6)
+            wq = (mesh.m * mesh.L0)[:, None] * model.gauss_w
+            ref = np.einsum("eg,egki,egkj->eij", wq, nmat, nmat)
+            ld = model.loading
+            for e, s_p, m_p in zip(ld.mass_elem, ld.mass_s, ld.mass_value, strict=True):
+                sq = np.zeros((mesh.n_elements, 1))
+                sq[e, 0] = s_p
+                nk = model.elements.interpolation(state, sq)[e, 0]
+                ref[e] += m_p * nk.T @ nk
+            np.testing.assert_allclose(me, ref, rtol=0, atol=1e-12 * scale)
+            np.testing.assert_allclose(model.element_mass(state), ref, rtol=0,
                                        atol=1e-12 * scale)
 
 
