@@ -787,7 +787,9 @@ class Elements:
         return out
 
     def _point_mass_csr(self, point_masses):
-        key = id(point_masses)
+        """(element, s, mass) arrays -> CSR by element; cached on the arrays' identity (the
+        caller passes the same loading arrays at every residual, in a new tuple each time)."""
+        key = None if point_masses is None else tuple(id(a) for a in point_masses)
         cached = getattr(self, "_pm_cache", None)
         if cached is not None and cached[0] == key:
             return cached[1]
