@@ -304,14 +304,35 @@ class TransientProblem:
         if conf is None:
             raise SolverError("transient start: an element cannot be solved in the initial "
                               "configuration", termination="initial state")
+        mdata = self.mass_data(conf)
+        mff = self.ff(mdata).tocsc()
+        v0 = v0 + self._velocity_jump(t0, V, mdata, mff)
         V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
         f = self.dynamic_force(t0, conf, V_full, A_full)  # M_fp a_p + C v + F - P
-        a0 = spla.spsolve(self.ff(self.mass_data(conf)).tocsc(), -f[self.fidx])
+        a0 = spla.spsolve(mff, -f[self.fidx])
         y0 = np.empty(2 * self.n)
         yp0 = np.empty(2 * self.n)
         y0[0::2], y0[1::2] = q0, v0
         yp0[0::2], yp0[1::2] = v0, a0
         return y0, yp0
+
+    def _velocity_jump(self, t0: float, V: np.ndarray, mdata: np.ndarray, mff) -> np.ndarray:
+        """Change of the free velocities when the supports start with a jump in velocity.
+
+        A prescribed support velocity that jumps at the start (A = a sin ωt after a rest)
+        acts through an impulsive reaction on the supports only: no impulse reaches a free
+        dof, so its generalised momentum p_f = M_ff v_f + M_fs v_s is continuous. The free
+        velocities therefore jump by -M_ff⁻¹ M_fs Δv_s; this is also the start of least
+        kinetic energy. With a lumped mass M_fs = 0 and nothing changes.
+        """
+        m = self.model
+        _, vp, _ = self._supports(t0)
+        dvs = vp - np.asarray(V, float).reshape(-1)[m.fixed]
+        if not np.any(dvs) or self.model.mass_model == "lumped":
+            return np.zeros(self.n)
+        full = m.pattern.matrix(mdata)
+        rhs = full[self.fidx][:, m.fixed] @ dvs
+        return -spla.spsolve(mff, rhs)
 
     def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
         """Positions, velocities, accelerations, tensions, reactions and energies at t."""
