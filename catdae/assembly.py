@@ -224,6 +224,14 @@ class Model:
             u[dof], v[dof], a[dof] = tf.evaluate(t)
         return u[self.fixed], v[self.fixed], a[self.fixed]
 
+    def breakpoints(self, t0: float, t1: float) -> np.ndarray:
+        """Sorted times in (t0, t1) where a support motion or a load has a kink or a jump."""
+        funcs = [tf for _, tf in self.motions]
+        funcs += [tf for tf, _ in self.loading.node_timed]
+        funcs += [tf for tf, _ in self.loading.internal_timed]
+        times = {float(b) for tf in funcs for b in tf.breakpoints()}
+        return np.array(sorted(b for b in times if t0 < b < t1), float)
+
     def support_positions(self, t: float) -> np.ndarray:
         """Positions of the fixed dofs at time t: case position + motion, (n_fixed,)."""
         return self.mesh.X0.ravel()[self.fixed] + self.support_values(t)[0]

@@ -558,6 +558,7 @@ class _RampTF(BaseModel):
     duration: Pos
     start: float = 0.0
     smooth: bool = False
+    amplitude: float = 1.0
 
 
 class _SineTF(BaseModel):
@@ -1166,7 +1167,7 @@ class _Builder:
         if kind == "constant":
             return Constant(float(v.value))
         if kind == "ramp":
-            return Ramp(float(v.duration), float(v.start), v.smooth)
+            return Ramp(float(v.duration), float(v.start), v.smooth, float(v.amplitude))
         if kind in ("sine", "cosine"):
             cls = Sine if kind == "sine" else Cosine
             return cls(float(v.amplitude), float(v.frequency), float(v.phase), float(v.offset))

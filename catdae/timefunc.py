@@ -67,6 +67,15 @@ class TimeFunction:
     def _evaluate(self, t: np.ndarray):  # pragma: no cover - every subclass overrides it
         raise NotImplementedError
 
+    def breakpoints(self) -> tuple[float, ...]:
+        """Times where the first or second derivative jumps (none for a smooth function).
+
+        A transient step stops its integrator there and restarts it: a jump in a support's
+        velocity is an impulse, handled by momentum balance, and a jump in acceleration is a
+        step in force that the integrator should not have to find by trial.
+        """
+        return ()
+
 
 @dataclass(frozen=True)
 class Constant(TimeFunction):
@@ -81,7 +90,7 @@ class Constant(TimeFunction):
 
 @dataclass(frozen=True)
 class Ramp(TimeFunction):
-    """A ramp from 0 (before ``start``) to 1 (after ``start + duration``).
+    """A ramp from 0 (before ``start``) to ``amplitude`` (default 1, after ``start + duration``).
 
     With ``smooth = False`` the ramp is linear: its slope ``1/duration`` jumps at both corners and
     its second derivative is returned as 0 everywhere (the Dirac impulses at the corners are not
@@ -94,10 +103,12 @@ class Ramp(TimeFunction):
     duration: float
     start: float = 0.0
     smooth: bool = False
+    amplitude: float = 1.0
     kind: ClassVar[str] = "ramp"
 
     def _evaluate(self, t):
         d = self.duration
+        a = self.amplitude
         x = (t - self.start) / d
         inside = (x >= 0.0) & (x < 1.0)
         xc = np.clip(x, 0.0, 1.0)
@@ -105,8 +116,12 @@ class Ramp(TimeFunction):
             f = xc**3 * (10.0 - 15.0 * xc + 6.0 * xc**2)
             df = 30.0 * xc**2 * (1.0 - xc) ** 2 / d
             d2f = 60.0 * xc * (1.0 - xc) * (1.0 - 2.0 * xc) / d**2
-            return f, df, d2f
-        return xc, np.where(inside, 1.0 / d, 0.0), 0.0
+            return a * f, a * df, a * d2f
+        return a * xc, np.where(inside, a / d, 0.0), 0.0
+
+    def breakpoints(self) -> tuple[float, ...]:
+        # the smoothstep is C2 at both ends; the linear ramp's slope jumps at its corners
+        return () if self.smooth else (self.start, self.start + self.duration)
 
 
 @dataclass(frozen=True)
@@ -175,6 +190,11 @@ class Table(TimeFunction):
         inside = (t >= t0) & (t <= t1)
         sp = self._spline
         return sp(tc), np.where(inside, sp(tc, 1), 0.0), np.where(inside, sp(tc, 2), 0.0)
+
+    def breakpoints(self) -> tuple[float, ...]:
+        # the clamped spline meets the held end values with zero slope, but its second
+        # derivative jumps there
+        return (self.t[0], self.t[-1])
 
 
 ONE = Constant(1.0)

@@ -297,16 +297,39 @@ class TransientProblem:
 
     # ------------------------------------------------------------------ start and output
     def initial(self, t0: float, X: np.ndarray, V: np.ndarray):
-        """Consistent y0, yp0: v'(0) = M⁻¹ (P - C v - F - coupling) on the free dofs."""
-        q0 = X.reshape(-1)[self.fidx]
-        v0 = V.reshape(-1)[self.fidx]
+        """Consistent y0, yp0 at the start, from the previous step's positions and velocities."""
+        vs_before = np.asarray(V, float).reshape(-1)[self.model.fixed]
+        return self._consistent(t0, X.reshape(-1)[self.fidx], V.reshape(-1)[self.fidx],
+                                vs_before, "transient start")
+
+    def restart(self, t: float, y: np.ndarray):
+        """Consistent y, yp just after a breakpoint of the prescribed motions or loads."""
+        vs_before = self.model.support_values(float(np.nextafter(t, -np.inf)))[1]
+        return self._consistent(t, y[0::2], y[1::2], vs_before, f"restart at t = {t:.6g} s")
+
+    def _consistent(self, t0, q0, v0, vs_before, where):
+        """y0, yp0 with v'(0) = M⁻¹ (P - C v - F - coupling) on the free dofs.
+
+        A prescribed support velocity that jumps at t0 (A = a sin ωt after a rest, the corner
+        of a linear ramp) acts through an impulsive reaction on the supports only: no impulse
+        reaches a free dof, so its generalised momentum p_f = M_ff v_f + M_fs v_s is
+        continuous and the free velocities jump by -M_ff⁻¹ M_fs Δv_s. (Keeping v_f instead
+        would apply an impulse -M_fs Δv_s to the free dofs; with the consistent catenary mass,
+        which amplifies chord motion in slack elements, that impulse grows with the mesh.)
+        With a lumped mass M_fs = 0 and nothing changes.
+        """
+        m = self.model
         conf = self.configuration(t0, q0)
         if conf is None:
-            raise SolverError("transient start: an element cannot be solved in the initial "
-                              "configuration", termination="initial state")
+            raise SolverError(f"{where}: an element cannot be solved in the configuration",
+                              termination="initial state")
         mdata = self.mass_data(conf)
         mff = self.ff(mdata).tocsc()
-        v0 = v0 + self._velocity_jump(t0, V, mdata, mff)
+        dvs = self._supports(t0)[1] - vs_before
+        v0 = np.array(v0, float)
+        if np.any(dvs) and m.mass_model != "lumped":
+            full = m.pattern.matrix(mdata)
+            v0 -= spla.spsolve(mff, full[self.fidx][:, m.fixed] @ dvs)
         V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
         f = self.dynamic_force(t0, conf, V_full, A_full)  # M_fp a_p + C v + F - P
         a0 = spla.spsolve(mff, -f[self.fidx])
@@ -315,24 +338,6 @@ class TransientProblem:
         y0[0::2], y0[1::2] = q0, v0
         yp0[0::2], yp0[1::2] = v0, a0
         return y0, yp0
-
-    def _velocity_jump(self, t0: float, V: np.ndarray, mdata: np.ndarray, mff) -> np.ndarray:
-        """Change of the free velocities when the supports start with a jump in velocity.
-
-        A prescribed support velocity that jumps at the start (A = a sin ωt after a rest)
-        acts through an impulsive reaction on the supports only: no impulse reaches a free
-        dof, so its generalised momentum p_f = M_ff v_f + M_fs v_s is continuous. The free
-        velocities therefore jump by -M_ff⁻¹ M_fs Δv_s; this is also the start of least
-        kinetic energy. With a lumped mass M_fs = 0 and nothing changes.
-        """
-        m = self.model
-        _, vp, _ = self._supports(t0)
-        dvs = vp - np.asarray(V, float).reshape(-1)[m.fixed]
-        if not np.any(dvs) or self.model.mass_model == "lumped":
-            return np.zeros(self.n)
-        full = m.pattern.matrix(mdata)
-        rhs = full[self.fidx][:, m.fixed] @ dvs
-        return -spla.spsolve(mff, rhs)
 
     def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
         """Positions, velocities, accelerations, tensions, reactions and energies at t."""
@@ -442,6 +447,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
         out_T[k], out_R[k], out_E[k] = T, R, E
 
     n_steps = 0
+    n_restarts = 0
     status = "completed"
     k_done = 0
     bar = _progress_bar(progress, t_end, step.name)
@@ -466,7 +472,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "paper" if model.mass_model == "consistent" else "lumped",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
-            "n_outputs": n_valid,
+            "n_outputs": n_valid, "n_restarts": n_restarts,
         }
         return results.transient_dataset(model.mesh, times[sl], out_X[sl], out_V[sl],
                                           out_A[sl], out_T[sl], out_R[sl], energy, attrs)
@@ -476,8 +482,13 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
         k_done = 1
         t_int = t0
         stalled = 0
+        # kinks and jumps of the prescribed motions and loads: the integrator stops at each
+        # and restarts from a consistent state (momentum balance across a velocity jump)
+        stops = [float(b) for b in model.breakpoints(t0, t_end)] + [t_end]
+        i_stop = 0
         while k_done < times.size:
-            res = solver.step(t_end, method="onestep", tstop=t_end)
+            t_stop = stops[i_stop]
+            res = solver.step(t_stop, method="onestep", tstop=t_stop)
             if not res.success:
                 status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
                 break
@@ -492,15 +503,29 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
                 status = (f"step size collapsed at t = {t_int:.6g} s (IDA could not advance; "
                           f"{prob.n_rejected} trial states rejected)")
                 break
+            y_last, yp_last = np.atleast_2d(res.y)[-1], np.atleast_2d(res.yp)[-1]
+            at_stop = t_stop < t_end and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0)
             while k_done < times.size and times[k_done] <= t_int * (1 + 1e-13) + 1e-300:
                 tk = times[k_done]
                 if abs(tk - t_int) <= 1e-13 * max(abs(t_int), 1.0):
-                    yk, ypk = np.atleast_2d(res.y)[-1], np.atleast_2d(res.yp)[-1]
+                    if at_stop:
+                        break  # recorded after the restart, with the velocities after it
+                    yk, ypk = y_last, yp_last
                 else:
                     ri = solver.step(tk, method="normal")
                     yk, ypk = np.atleast_2d(ri.y)[-1], np.atleast_2d(ri.yp)[-1]
                 record(k_done, tk, yk, ypk)
                 k_done += 1
+            if at_stop:
+                t_int = t_stop
+                y_last, yp_last = prob.restart(t_stop, y_last)
+                solver.init_step(t_stop, y_last, yp_last)
+                n_restarts += 1
+                i_stop += 1
+                while (k_done < times.size
+                       and abs(times[k_done] - t_int) <= 1e-13 * max(abs(t_int), 1.0)):
+                    record(k_done, times[k_done], y_last, yp_last)
+                    k_done += 1
             if bar is not None:
                 bar.update(t_int - bar.n)
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:

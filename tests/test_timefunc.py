@@ -143,3 +143,26 @@ def test_time_functions_are_frozen_hashable_and_picklable():
         assert hash(func) == hash(pickle.loads(pickle.dumps(func)))
     assert table == Table((0.0, 1.0), (0.0, 2.0), file="points.csv")
     assert pickle.loads(pickle.dumps(table))(0.5) == table(0.5)
+
+
+@settings(max_examples=30, deadline=None)
+@given(d=st.floats(0.1, 10.0), x=st.floats(0.01, 0.99), amp=st.floats(-5.0, 5.0))
+def test_ramp_amplitude_scales_value_and_derivatives(d, x, amp):
+    t = 1.0 + x * d
+    for smooth in (False, True):
+        base = np.array(Ramp(d, 1.0, smooth).evaluate(t))
+        np.testing.assert_allclose(Ramp(d, 1.0, smooth, amp).evaluate(t), amp * base,
+                                   rtol=1e-14, atol=1e-300)
+    check_derivatives(Ramp(d, 1.0, smooth=True, amplitude=amp), t, scale=d * 1e-2)
+
+
+def test_breakpoints_are_where_derivatives_jump():
+    """Each listed breakpoint shows a jump in f' or f'' across it; smooth functions list none."""
+    table = Table((0.5, 1.0, 2.0), (0.0, 1.0, 0.5))
+    for func in (Ramp(0.3, 0.2), table):
+        for b in func.breakpoints():
+            left = np.array(func.evaluate(b - 1e-9)[1:])
+            right = np.array(func.evaluate(b + 1e-9)[1:])
+            assert np.abs(left - right).max() > 1e-3, (func, b)
+    assert Sine(1.0, 2.0).breakpoints() == () and Constant(1.0).breakpoints() == ()
+    assert Ramp(0.3, 0.2, smooth=True).breakpoints() == ()
