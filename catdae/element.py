@@ -243,6 +243,18 @@ def _steep_start(c, l0, ea, w, lh, h):
 
 @njit(cache=True)
 def _solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout):
+    """Newton for one element, warm-started from ``h`` when ``use_h``; a warm start that
+    fails (e.g. from a folded vertical state to a taut one) is retried cold."""
+    it, status = _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout)
+    if status == NOT_CONVERGED and use_h:
+        it2, status = _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, False, tol, max_iter,
+                                  fout, kout)
+        it += it2
+    return it, status
+
+
+@njit(cache=True)
+def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout):
     """Newton with backtracking for one element. Returns (iterations, status)."""
     d = np.empty(3)
     f = np.empty(6)

@@ -807,3 +807,21 @@ def test_mixed_batch_matches_single_elements():
 
 def test_status_codes_are_distinct():
     assert len({CONVERGED, SLACK, NOT_CONVERGED}) == 3
+
+
+@pytest.mark.parametrize("stretch", [1e-9, 1e-6, 1e-3, 0.05])
+def test_warm_start_from_a_folded_vertical_state_to_a_taut_one(stretch):
+    """Newton warm-started from a folded (slack) vertical state reaches the taut hanging bar.
+
+    Closed form for a vertical chord longer than the unstretched hanging length: the top
+    tension T_top = EA (Δz - L0)/L0 + w L0/2 (the bar stretched by its mean tension)."""
+    L0, EA, w = 5.0, 1e8, 0.00981
+    el = Elements([L0], [EA], [w], PointLoads.from_lists([[]]))
+    folded = el.solve(np.array([[0.0, 0.0, -L0]]))
+    assert folded.status[0] == SLACK
+    dz = L0 * (1.0 + stretch) + 0.5 * w * L0**2 / EA
+    taut = el.solve(np.array([[0.0, 0.0, -dz]]), folded.h)
+    assert taut.status[0] == CONVERGED
+    t_top = EA * (dz - L0) / L0 + 0.5 * w * L0
+    # h is the force at end i (the top) on the element: pulling up-and-back along -chord
+    assert -taut.h[0, 2] == pytest.approx(t_top, rel=1e-9)
