@@ -98,11 +98,11 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
 
 
 def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
-    sol = solve_static(model, state.X, state.h, t=0.0, load_steps=step.load_steps)
+    sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
     return results.static_dataset(
-        model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, 0.0),
+        model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t),
         {"iterations": sol.iterations, "residual_norm": sol.residual_norm,
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),

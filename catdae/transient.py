@@ -402,16 +402,16 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     """Integrate one transient step from ``state`` (positions, velocities, tensions)."""
     wall0 = _time.perf_counter()
     prob = TransientProblem(model, step, state.X, state.h)
-    t0 = 0.0
-    t_end = float(step.duration)
+    t0 = float(state.t)  # one clock for the whole case: a transient continues the time
+    t_end = t0 + float(step.duration)
     dt_out = float(step.output_interval)
-    n_out = int(np.floor(t_end / dt_out + 1e-9)) + 1
+    n_out = int(np.floor((t_end - t0) / dt_out + 1e-9)) + 1
     times = t0 + dt_out * np.arange(n_out)
     if times[-1] < t_end - 1e-12 * t_end:
         times = np.append(times, t_end)
     y0, yp0 = prob.initial(t0, state.X, state.V)
     linsolver = choose_solver(prob, step.linear_solver)
-    omega = _reference_frequency(prob, y0)
+    omega = _reference_frequency(prob, t0, y0)
     atol = np.empty(2 * prob.n)
     atol[0::2] = step.atol
     atol[1::2] = step.atol * omega
@@ -450,7 +450,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     n_restarts = 0
     status = "completed"
     k_done = 0
-    bar = _progress_bar(progress, t_end, step.name)
+    bar = _progress_bar(progress, t_end - t0, step.name)
     last_write = _time.perf_counter()
 
     def dataset(n_valid):
@@ -527,7 +527,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
                     record(k_done, times[k_done], y_last, yp_last)
                     k_done += 1
             if bar is not None:
-                bar.update(t_int - bar.n)
+                bar.update(t_int - t0 - bar.n)
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(step.name, dataset(k_done))
                 last_write = _time.perf_counter()
@@ -546,12 +546,13 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     state.X = out_X[-1].copy()
     state.V = out_V[-1].copy()
     state.h = prob.h
+    state.t = t_end
     return ds
 
 
-def _reference_frequency(prob: TransientProblem, y0: np.ndarray) -> float:
+def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:
     """ω of the lowest mode about the start (rad/s): scales the velocity tolerance."""
-    conf = prob.configuration(0.0, y0[0::2])
+    conf = prob.configuration(t0, y0[0::2])
     try:
         mff = prob.ff(prob.mass_data(conf))
         kff = prob.ff(prob.model.pattern.assemble(conf[0].stiffness6))

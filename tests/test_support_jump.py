@@ -133,3 +133,32 @@ def test_velocity_jumps_inside_a_step_are_impulses(tmp_path):
     assert errors[-1] < 2e-3 * scale, (errors, scale)
     rates = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     assert np.all(rates > 0.7), (errors, rates)
+
+
+def test_transient_steps_continue_the_clock(tmp_path):
+    """Two transient steps of 0.5 s give the history of one step of 1 s: the support motion
+    continues (it does not jump back to its t = 0 position) and the second step's time axis
+    runs on from the first's."""
+    one = _case(tmp_path, "one", duration=1.0)
+    text = one.read_text()
+    head, sep, tail = text.partition("[[steps]]\nkind = \"transient\"")
+    assert sep
+    step = sep + tail.replace("duration = 1.0", "duration = 0.5")
+    two = tmp_path / "two.toml"
+    two.write_text(head + step.replace('name = "excitation"', 'name = "first"') + "\n"
+                   + step.replace('name = "excitation"', 'name = "second"'))
+    tol = {"rtol": 1e-8, "atol": 1e-10, "elements": 10, "progress": False}
+    ref = catdae.run(one, **tol)["excitation"].ds
+    tree = catdae.run(two, **tol)
+    first, second = tree["first"].ds, tree["second"].ds
+    np.testing.assert_allclose(first.time.values, np.arange(51) * 0.01, atol=1e-12)
+    np.testing.assert_allclose(second.time.values, 0.5 + np.arange(51) * 0.01, atol=1e-12)
+    # the support follows A_z = a sin πt through both steps
+    z_a = second.position.sel(node="A", axis="z").values
+    np.testing.assert_allclose(z_a, 0.03 * np.sin(np.pi * second.time.values), atol=1e-12)
+    peak = float(np.abs(ref.displacement).max())
+    for part in (first, second):
+        np.testing.assert_allclose(part.displacement.values,
+                                   ref.displacement.sel(time=part.time.values,
+                                                        method="nearest").values,
+                                   atol=1e-5 * peak)
