@@ -43,11 +43,11 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         **overrides) -> xr.DataTree:
     """Run every step of a case and return an ``xarray.DataTree`` with one group per step.
 
-    ``overrides`` (rtol, atol, elements) replace the case's values. With ``output`` the tree is
-    also written to netCDF-4; long transient steps write it in increments as they go. On
-    failure a CatdaeError is raised whose ``partial`` attribute holds the tree computed so far
-    (status says why); with ``output`` that partial tree is written too, never over an existing
-    file (it goes to ``<output stem>.failed.nc`` then).
+    ``overrides`` (rtol, atol, elements, mass_model) replace the case's values. With
+    ``output`` the tree is also written to netCDF-4; long transient steps write it in
+    increments as they go. On failure a CatdaeError is raised whose ``partial`` attribute
+    holds the tree computed so far (status says why); with ``output`` that partial tree is
+    written too, never over an existing file (it goes to ``<output stem>.failed.nc`` then).
     """
     case = as_case(case_or_path)
     ov = {k: v for k, v in overrides.items() if v is not None}

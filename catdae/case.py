@@ -286,8 +286,9 @@ class Case:
         return self.materials[c.material]
 
     def with_overrides(self, rtol: float | None = None, atol: float | None = None,
-                       elements: int | None = None) -> Case:
-        """A new Case with ``rtol``/``atol`` set on every transient step and ``elements`` on
+                       elements: int | None = None, mass_model: str | None = None) -> Case:
+        """A new Case with ``rtol``/``atol`` set on every transient step, ``mass_model``
+        ("consistent" or "lumped") on every transient and modal step, and ``elements`` on
         every cable (``None`` leaves a setting as it is).
 
         Raises ``CaseError`` if a value is invalid, or if a load or point mass names a mesh node
@@ -302,6 +303,9 @@ class Case:
             and elements >= 1
         ):
             problems.append(("elements", f"expected an integer >= 1, found {_found(elements)}"))
+        if mass_model is not None and mass_model not in ("consistent", "lumped"):
+            problems.append(("mass_model", 'expected "consistent" or "lumped", found '
+                             f"{_found(mass_model)}"))
         if problems:
             raise CaseError(self.path, problems)
         steps = tuple(
@@ -310,6 +314,9 @@ class Case:
             if s.kind == "transient" else s
             for s in self.steps
         )
+        if mass_model is not None:
+            steps = tuple(replace(s, mass_model=mass_model) if s.kind != "static" else s
+                          for s in steps)
         cables = self.cables
         if elements is not None:
             cables = tuple(replace(c, elements=int(elements)) for c in cables)

@@ -35,6 +35,8 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--rtol", type=float, help="relative tolerance of transient steps")
     r.add_argument("--atol", type=float, help="absolute tolerance of transient steps, m")
     r.add_argument("--elements", type=int, help="elements per cable")
+    r.add_argument("--mass-model", choices=("consistent", "lumped"),
+                   help="mass model of every transient and modal step")
     r.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: on a terminal)")
     c = sub.add_parser("check", help="validate a case file and report every problem")
@@ -97,7 +99,7 @@ def _run(args) -> int:
         return 2
     try:
         tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
-                   elements=args.elements)
+                   elements=args.elements, mass_model=args.mass_model)
     except CaseError:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:

@@ -59,6 +59,23 @@ def test_run_default_output_and_overrides(tmp_path, monkeypatch, capsys):
     assert tree["equilibrium"].to_dataset().element.size == 9
 
 
+def test_mass_model_override(tmp_path, capsys):
+    """--mass-model sets the mass of modal (and transient) steps: the lumped mass bounds the
+    frequencies from below, the consistent mass from above."""
+    f = {}
+    for mm in ("consistent", "lumped"):
+        out = tmp_path / f"{mm}.nc"
+        assert main(["run", str(THREE), "--mass-model", mm, "-o", str(out)]) == 0
+        ds = catdae.read_results(out)["modes"].to_dataset()
+        assert ds.attrs["mass_model"] == mm
+        f[mm] = ds.frequency.values
+    assert np.all(f["lumped"] < f["consistent"])
+    with pytest.raises(SystemExit) as info:
+        main(["run", str(THREE), "--mass-model", "heavy"])
+    assert info.value.code == 2
+    assert "--mass-model" in capsys.readouterr().err
+
+
 def test_check_valid_case(capsys):
     assert main(["check", str(THREE)]) == 0
     out = capsys.readouterr().out

@@ -551,7 +551,7 @@ def test_violent_example2_work_energy_balance(tmp_path, mass_model, dt):
     text = (CASES / "example2_support_motion_violent.toml").read_text()
     text = text.replace("duration = 4.0", "duration = 1.0").replace(
         "output_interval = 0.01", f"output_interval = {dt}").replace(
-        'kind = "transient"', f'kind = "transient"\nmass_model = "{mass_model}"')
+        'mass_model = "lumped"', f'mass_model = "{mass_model}"')
     case = tmp_path / "violent.toml"
     case.write_text(text)
     ds = catdae.run(case, elements=10, rtol=1e-7, progress=False)["excitation"].to_dataset()
