@@ -291,8 +291,9 @@ class Case:
         ("consistent" or "lumped") on every transient and modal step, and ``elements`` on
         every cable (``None`` leaves a setting as it is).
 
-        Raises ``CaseError`` if a value is invalid, or if a load or point mass names a mesh node
-        that no longer exists with the new number of elements.
+        With a new ``elements``, a load or point mass placed on a mesh node ``<cable>.<k>`` is
+        kept at the same place on the cable (its unstrained arc length in the case's mesh).
+        Raises ``CaseError`` if a value is invalid.
         """
         problems: list[tuple[str, str]] = []
         for key, value in (("rtol", rtol), ("atol", atol)):
@@ -318,18 +319,25 @@ class Case:
             steps = tuple(replace(s, mass_model=mass_model) if s.kind != "static" else s
                           for s in steps)
         cables = self.cables
+        point_masses, loads = self.point_masses, self.loads
         if elements is not None:
             cables = tuple(replace(c, elements=int(elements)) for c in cables)
-            elems = {c.name: c.elements for c in cables}
-            for section, items in (("point_masses", self.point_masses), ("loads", self.loads)):
-                for i, item in enumerate(items):
-                    if item.node is not None and item.node not in self.nodes:
-                        msg = _mesh_node_problem(item.node, elems)
-                        if msg:
-                            problems.append((_fmt_path((section, i, "node")), msg))
-            if problems:
-                raise CaseError(self.path, problems)
-        return replace(self, steps=steps, cables=cables)
+            # a mass or load placed on a mesh node <cable>.<k> stays where it is on the cable:
+            # at the unstrained arc length k L0 / n of the case's own mesh, which the new mesh
+            # carries exactly (at a node, or inside an element)
+            by_name = {c.name: c for c in self.cables}
+
+            def keep_place(item):
+                if item.node is None or item.node in self.nodes:
+                    return item
+                cable, _, k = item.node.rpartition(".")
+                c = by_name[cable]
+                return replace(item, node=None, cable=cable, s=int(k) * c.length / c.elements)
+
+            point_masses = tuple(keep_place(p) for p in point_masses)
+            loads = tuple(keep_place(p) for p in loads)
+        return replace(self, steps=steps, cables=cables, point_masses=point_masses,
+                       loads=loads)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -754,6 +762,13 @@ class _Builder:
         nodes = self.nodes(top.nodes)
         supports = self.supports(top.supports, nodes)
         cables = self.cables(top.cables, materials, nodes)
+        if not top.cables and "cables" not in bad:
+            self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "
+                         '(name, ends = ["A", "B"], material, length)')
+        for key in sorted(self.node_names - self.cable_ends - self.support_names):
+            if top.cables:
+                self.problem(("nodes", key), f"node {key!r} is not an end of any cable and "
+                             "not supported: nothing holds it (remove it, or use it)")
         point_masses = self.located(top.point_masses, "point_masses", _PointMass, cables, nodes)
         loads = self.located(top.loads, "loads", _Load, cables, nodes)
         distributed = self.distributed(top.distributed_loads, cables)

@@ -80,7 +80,7 @@ def _check(args) -> int:
     from .case import load_case
     from .mesh import build_mesh
 
-    case = load_case(args.case)
+    case = load_case(Path(args.case))  # the command line always names a file
     mesh = build_mesh(case)
     print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
           f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")

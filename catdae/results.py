@@ -25,15 +25,15 @@ def _var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
 def _coords(mesh: Mesh, with_elements: bool = True) -> dict:
     coords = {
         "node": xr.Variable("node", np.array(mesh.node_names, dtype=object),
-                            {"long_name": "node name"}),
+                            {"units": "1", "long_name": "node name"}),
         "axis": xr.Variable("axis", np.array(AXES, dtype=object),
-                            {"long_name": "global axis (z up)"}),
+                            {"units": "1", "long_name": "global axis (z up)"}),
     }
     if with_elements:
         coords["element"] = xr.Variable("element", np.array(mesh.element_names, dtype=object),
-                                        {"long_name": "element name"})
+                                        {"units": "1", "long_name": "element name"})
         coords["end"] = xr.Variable("end", np.array(["i", "j"], dtype=object),
-                                    {"long_name": "element end"})
+                                    {"units": "1", "long_name": "element end"})
     return coords
 
 
@@ -73,7 +73,7 @@ def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.
     )
     if cables is not None:
         ds = ds.assign_coords(cable=xr.Variable("cable", np.array(mesh.cable_names, dtype=object),
-                                                {"long_name": "cable name"}))
+                                                {"units": "1", "long_name": "cable name"}))
         ds["cable_end_tension"] = _var(("cable", "end"), cables["end_tension"], "N",
                                        "tension at the cable's first (i) and last (j) end")
         ds["horizontal_tension"] = _var("cable", cables["horizontal_tension"], "N",
@@ -88,7 +88,8 @@ def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, s
     """Modal step: frequencies (n_modes,) Hz and shapes (n_modes, n_nodes, 3), unit maximum."""
     n = len(frequency)
     coords = _coords(mesh, with_elements=False)
-    coords["mode"] = xr.Variable("mode", np.arange(1, n + 1), {"long_name": "mode number"})
+    coords["mode"] = xr.Variable("mode", np.arange(1, n + 1),
+                                 {"units": "1", "long_name": "mode number"})
     ds = xr.Dataset(
         {
             "frequency": _var("mode", frequency, "Hz", "natural frequency"),

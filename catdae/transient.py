@@ -359,7 +359,8 @@ class TransientProblem:
 
 
 def _potential(model: Model, X: np.ndarray, state: ElementState, t: float):
-    """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J."""
+    """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J (loads with a
+    time function have no potential: their work changes the total energy)."""
     mesh = model.mesh
     el = model.elements
     xi, wi = _GAUSS8
@@ -378,8 +379,10 @@ def _potential(model: Model, X: np.ndarray, state: ElementState, t: float):
         slot = np.arange(ld.internal_s.size) - ld.internal_ptr[e_of]
         sq[e_of, slot] = ld.internal_s
         xk = X[mesh.conn[:, 0]][:, None, :] + el.position(state.h, sq)
-        gravity -= float(np.sum(el.loads.f * xk[e_of, slot]))
-    gravity -= float(model.nodal_load(t) @ X.reshape(-1))
+        gravity -= float(np.sum(ld.internal_force * xk[e_of, slot]))
+    # only the constant loads have a potential; the work of loads that vary in time (like that
+    # of moving supports) changes the total energy instead
+    gravity -= float(ld.node_force.reshape(-1) @ X.reshape(-1))
     return strain, gravity
 
 

@@ -227,11 +227,17 @@ def test_with_overrides():
     with pytest.raises(CaseError) as info:
         case.with_overrides(rtol=-1.0, elements=0)
     assert {p for p, _ in info.value.problems} == {"rtol", "elements"}
-    # main.7 does not exist with 4 elements
-    with pytest.raises(CaseError) as info:
-        case.with_overrides(elements=4)
-    ((path, message),) = info.value.problems
-    assert path == "loads[0].node" and "main.1 .. main.3" in message
+    # main.7 (midspan of 14 elements) does not exist with 4 elements: the load stays at
+    # midspan, s = 7 L0 / 14, and lands on mesh node main.2 of the new mesh
+    four = case.with_overrides(elements=4)
+    (gust,) = four.loads
+    assert gust.node is None and gust.cable == "main"
+    assert gust.s == pytest.approx(case.cables[0].length / 2, rel=1e-15)
+    from catdae.mesh import build_mesh
+
+    mesh = build_mesh(four)
+    kind, index, _ = mesh.locate("main", gust.s)
+    assert kind == "node" and mesh.node_names[index] == "main.2"
 
 
 def test_rayleigh_coefficients_give_the_ratio_at_both_frequencies():

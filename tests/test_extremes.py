@@ -634,6 +634,12 @@ BAD = {
     "strain above 50 %": (_edit("length = 11.0", "length = 6.0"), "cables[0].length", "50%"),
     "load on a mesh node that does not exist": (_edit('node = "c.1"', 'node = "c.9"'),
                                                 "loads[0].node", "c.9"),
+    "no cable at all": (
+        _edit('[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "m"\nlength = 11.0\n'
+              'elements = 2\n[[loads]]\nname = "p"\nnode = "c.1"\nforce = [0.0, 0.0, -1.0]\n',
+              ""), "cables", "no cable"),
+    "a free node on no cable": (_edit("B = [10.0, 0.0, 0.0]", "B = [10.0, 0.0, 0.0]\n"
+                                      "Q = [5.0, 5.0, 0.0]"), "nodes.Q", "not an end of any"),
 }
 
 
@@ -665,6 +671,17 @@ def test_bad_input_is_exit_2_and_one_clear_message(tmp_path, capsys, name, comma
         assert all(ln.startswith(f"{f}: ") for ln in lines[1:]), err
     assert any(f"{f}: {field}" in ln and expected in ln for ln in lines), err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["check", "run"])
+@pytest.mark.parametrize("what", ["missing", "directory"])
+def test_a_case_path_that_is_no_file(tmp_path, capsys, command, what):
+    """The command line always reads its argument as a path, with or without .toml."""
+    path = tmp_path / "mycase" if what == "missing" else tmp_path
+    assert main([command, str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"catdae: invalid case: {path}: cannot read the case file"), err
+    assert "TOML" not in err
 
 
 @pytest.mark.parametrize("command", ["check", "run"])

@@ -110,6 +110,7 @@ def test_every_variable_is_labelled(written):
                 assert ds[v].attrs.get("long_name"), (name, v)
             for c in ds.coords:
                 assert ds[c].attrs.get("long_name"), (name, c)
+                assert ds[c].attrs.get("units"), (name, c)  # "1" for names and numbers
 
 
 def test_root_attributes_carry_the_provenance(written):

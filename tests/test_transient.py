@@ -325,3 +325,34 @@ def test_failure_keeps_partial_results(tmp_path, monkeypatch):
     assert np.isfinite(ds.position.values).all()
     assert "loaded" in tree.children  # the static step before it is kept
     assert info.value.partial is not None
+
+
+def test_energy_balance_with_a_time_varying_load():
+    """A load with a time function has no potential: the total energy changes by its work,
+    E(t) - E(0) = ∫ P(t)·v dt (trapezoid over fine outputs), and is not shifted by -P(t)·x."""
+    text = taut_case(steps="""
+[[steps]]
+kind = "static"
+name = "hanging"
+[[steps]]
+kind = "transient"
+name = "forced"
+duration = 0.5
+output_interval = 0.0005
+rtol = 1e-9
+atol = 1e-11
+""", extra="""
+[[loads]]
+name = "shake"
+node = "c.3"
+force = [0.0, 200.0, 50.0]
+time = { kind = "sine", amplitude = 1.0, frequency = 3.0, offset = 0.5 }
+""")
+    ds = catdae.run(text, progress=False)["forced"].to_dataset()
+    t = ds.time.values
+    f = 0.5 + np.sin(2 * np.pi * 3.0 * t)
+    power = f * (ds.velocity.sel(node="c.3").values @ np.array([0.0, 200.0, 50.0]))
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+    e = ds.energy_total.values - ds.energy_total.values[0]
+    assert np.abs(work).max() > 1.0  # the load does real work
+    np.testing.assert_allclose(e, work, atol=1e-3 * np.abs(work).max())
