@@ -15,16 +15,16 @@ import sys
 import netCDF4
 import numpy as np
 import pytest
-from scipy.integrate import cumulative_trapezoid
-from scipy.optimize import brentq, fsolve
-
-import catdae
 from reference import (
     _segment,
     irvine_catenary,
     irvine_catenary_inclined_3d,
     taut_string_frequencies,
 )
+from scipy.integrate import cumulative_trapezoid
+from scipy.optimize import brentq, fsolve
+
+import catdae
 
 G = 9.81
 
@@ -373,7 +373,7 @@ def test_support_motion_is_followed_exactly_and_its_work_is_the_energy_gain(mass
         mass = dict.fromkeys(ds.node.values, 0.0)
         for c, (i, j) in {"am": ("A", "M"), "mb": ("M", "B"), "cm": ("C", "M")}.items():
             nodes = [i, f"{c}.1", j]
-            for a, b in zip(nodes[:-1], nodes[1:]):
+            for a, b in zip(nodes[:-1], nodes[1:], strict=True):
                 mass[a] += 1.0 * le[c]
                 mass[b] += 1.0 * le[c]
         mvec = np.array([mass[n] for n in ds.node.values])
@@ -401,7 +401,8 @@ atol = 1e-11
 DAMPING
 """
     ys = {}
-    for key, d in (("none", ""), ("rayleigh", 'damping = { kind = "rayleigh", alpha = 0.8, beta = 0.0 }'),
+    rayleigh = 'damping = { kind = "rayleigh", alpha = 0.8, beta = 0.0 }'
+    for key, d in (("none", ""), ("rayleigh", rayleigh),
                    ("material", 'damping = { kind = "material" }')):
         case = single_span((10.05, 0.0, 0.0), 10.0, 1.0e6, 2.0, 8, extra,
                            steps.replace("DAMPING", d), gravity=0.0)
@@ -416,7 +417,8 @@ DAMPING
     # small, linear oscillation: damped = undamped modes times exp(-alpha t/2) (frequency shift
     # sqrt(1 - zeta^2) is below 1e-4 here)
     env = np.exp(-0.4 * t)
-    np.testing.assert_allclose(ys["rayleigh"], ys["none"] * env, atol=2e-2 * np.abs(ys["none"]).max())
+    np.testing.assert_allclose(ys["rayleigh"], ys["none"] * env,
+                               atol=2e-2 * np.abs(ys["none"]).max())
 
 
 # --------------------------------------------------------------------------------------------------
