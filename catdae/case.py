@@ -235,7 +235,7 @@ class Step:
     damping: Damping | None = None
     max_order: int = 5
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["consistent", "lumped"] = "consistent"
+    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
@@ -304,9 +304,9 @@ class Case:
             and elements >= 1
         ):
             problems.append(("elements", f"expected an integer >= 1, found {_found(elements)}"))
-        if mass_model is not None and mass_model not in ("consistent", "lumped"):
-            problems.append(("mass_model", 'expected "consistent" or "lumped", found '
-                             f"{_found(mass_model)}"))
+        if mass_model is not None and mass_model not in ("consistent", "lumped", "linear"):
+            problems.append(("mass_model", 'expected "consistent", "lumped" or "linear", '
+                             f"found {_found(mass_model)}"))
         if problems:
             raise CaseError(self.path, problems)
         steps = tuple(
@@ -518,7 +518,7 @@ class _ModalStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
-    mass_model: Literal["consistent", "lumped"] = "consistent"
+    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
 
 
 class _TransientStep(BaseModel):
@@ -533,7 +533,7 @@ class _TransientStep(BaseModel):
     damping: TomlTable | None = None
     max_order: Annotated[int, Field(ge=1, le=5)] = 5
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["consistent", "lumped"] = "consistent"
+    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 

@@ -472,7 +472,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "atol_velocity": step.atol * omega, "status": status, "linear_solver": linsolver,
             "bandwidth": prob.bandwidth, "max_order": int(step.max_order),
             "mass_model": model.mass_model, "inertia": step.inertia if prob.lagrangian else
-            "paper" if model.mass_model == "consistent" else "lumped",
+            "paper" if model.mass_model == "consistent" else "constant mass",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
             "n_outputs": n_valid, "n_restarts": n_restarts,

@@ -201,8 +201,8 @@ def _frequencies(d, n, mass_model):
 @pytest.mark.parametrize(("lambda2", "sag_ratio", "meshes"),
                          [(1.0, 1 / 200, (4, 8, 16, 32)), (100.0, 1 / 50, (8, 16, 32, 64))])
 def test_convergence_order(lambda2, sag_ratio, meshes):
-    """Frequencies converge at order 2 in the element size, from above with the consistent mass
-    and from below with the lumped mass, to the same limit.
+    """Frequencies converge at order 2 in the element size, from above with the consistent and
+    the linear (straight-line) mass and from below with the lumped mass, to the same limit.
 
     Why 2: along the cable the interpolation functions N(s) = [I - G(s) K, G(s) K] are, to
     leading order, the linear ones [(1 - s/L0) I, (s/L0) I] (exact for statics, but a motion
@@ -217,11 +217,14 @@ def test_convergence_order(lambda2, sag_ratio, meshes):
     """
     fine_c, sym_c = _frequencies(d := design(lambda2, sag_ratio), 512, "consistent")
     fine_l, sym_l = _frequencies(d, 512, "lumped")
-    # same limit: the two mass models differ at 512 elements only by their O(h²) errors
+    fine_s, sym_s = _frequencies(d, 512, "linear")
+    # same limit: the mass models differ at 512 elements only by their O(h²) errors
     np.testing.assert_allclose(fine_c[:6], fine_l[:6], rtol=1e-4)
+    np.testing.assert_allclose(fine_c[:6], fine_s[:6], rtol=1e-4)
     logn = np.log(meshes)
     for mass_model, fine, sym_fine, sign in (("consistent", fine_c, sym_c, 1.0),
-                                            ("lumped", fine_l, sym_l, -1.0)):
+                                            ("lumped", fine_l, sym_l, -1.0),
+                                            ("linear", fine_s, sym_s, 1.0)):
         err_modes = []
         err_sym = []
         for n in meshes:
@@ -230,8 +233,12 @@ def test_convergence_order(lambda2, sag_ratio, meshes):
             err_sym.append(sym / sym_fine - 1.0)
         errs = np.column_stack([np.array(err_sym), np.array(err_modes)])  # (n_mesh, 3)
         assert np.all(sign * errs > 0), f"{mass_model}: not converging from the expected side"
+        # the straight-line mass misses the sag kinematics that the symmetric in-plane mode of
+        # a λ² = 100 cable is made of: pre-asymptotic at the coarsest mesh (slopes 0.9, 1.8,
+        # 2.0 from 8 to 64 elements), so its order is fitted from the second mesh on
+        first = 1 if mass_model == "linear" else 0
         for j in range(errs.shape[1]):
-            slope = np.polyfit(logn, np.log(np.abs(errs[:, j])), 1)[0]
+            slope = np.polyfit(logn[first:], np.log(np.abs(errs[first:, j])), 1)[0]
             assert -2.2 < slope < -1.8, (mass_model, j, slope, errs[:, j])
 
 
@@ -375,7 +382,7 @@ def _configurations(name, case, model, rng):
     yield X, "perturbed"
 
 
-@pytest.mark.parametrize("mass_model", ["consistent", "lumped"])
+@pytest.mark.parametrize("mass_model", ["consistent", "lumped", "linear"])
 @pytest.mark.parametrize("name", list(MASS_SCENES))
 def test_mass_matrix_identities(name, mass_model):
     """rᵀ M r = total mass for a rigid translation r (Φ_i(s) + Φ_j(s) = I at every s, and the
