@@ -16,6 +16,7 @@ rtol = 1e-10 (atol 1e-12 m) on the same mesh.
 Run apart from the tests:
 
     python benchmarks/transient_speed.py [--part accuracy|scaling|profile|all] [--quick]
+    python benchmarks/transient_speed.py --part scaling --sizes 10,50,100,200 --repeat 2
 
 It prints markdown tables (copied into ``benchmarks/transient_speed.md``).
 """
@@ -114,8 +115,10 @@ def run_dict(d: dict) -> tuple:
     case = case_from_dict(d)
     name = d["steps"][-1]["name"]
     t0 = time.perf_counter()
+    c0 = time.process_time()
     tree = catdae.run(case, progress=False)
     wall = time.perf_counter() - t0
+    tree[name].ds.attrs["bench_cpu_time"] = time.process_time() - c0  # whole run, this process
     return tree[name].ds, tree, wall
 
 
@@ -140,6 +143,7 @@ def row(ds, err=None, **extra) -> dict:
            "solver": str(a["linear_solver"]), "bandwidth": int(a["bandwidth"]),
            "status": str(a["status"]), "duration": float(ds.time.values[-1])}
     out["us_per_res"] = 1e6 * out["wall"] / max(out["nres"], 1)
+    out["cpu"] = float(a.get("bench_cpu_time", np.nan))
     if err is not None:
         out["err"] = err
     out.update(extra)
@@ -195,26 +199,40 @@ def accuracy(quick: bool = False) -> dict:
 
 
 # --------------------------------------------------------------------------------- part 2
-def scaling(quick: bool = False) -> list:
+def scaling(quick: bool = False, sizes=None, solvers=("auto", "band", "sparse"), repeat=1,
+            duration_scale: float = 1.0) -> list:
+    """Cost against mesh size. With ``repeat`` > 1 the solvers of one size are run in turn
+    (band, sparse, band, sparse, ...) and every run is kept: take the fastest of each."""
     rows = []
-    sizes = (10, 50, 200, 1000, 2000)
-    for ne in sizes[:3] if quick else sizes:
-        duration = DURATIONS[ne]
+    sizes = sizes or ((10, 50, 200) if quick else (10, 50, 200, 1000, 2000))
+    for ne in sizes:
+        duration = duration_scale * DURATIONS.get(ne) if ne in DURATIONS else \
+            duration_scale * _duration_for(ne)
         used = None
-        for solver in ("auto", "band", "sparse"):
-            if solver == used:  # 'auto' already ran it
-                continue
-            d = cable_dict(ne, duration, min(0.01, duration / 10), **tol(1e-6),
-                           linear_solver=solver)
-            ds, _, _ = run_dict(d)
-            used = used or str(ds.attrs["linear_solver"])
-            r = row(ds, ne=ne, requested=solver)
-            r["per_sim_s"] = r["wall"] / r["duration"]
-            rows.append(r)
-            print(f"  {ne} elements {solver} ({r['solver']}): {r['wall']:.2f} s for "
-                  f"{r['duration']} s, {r['steps']} steps, {r['us_per_res']:.0f} us/res",
-                  file=sys.stderr)
+        for k in range(repeat):
+            for solver in solvers:
+                if solver == "auto" and k > 0:
+                    continue
+                if solver == used and k == 0:  # 'auto' already ran it
+                    continue
+                d = cable_dict(ne, duration, min(0.01, duration / 10), **tol(1e-6),
+                               linear_solver=solver)
+                ds, _, _ = run_dict(d)
+                if solver == "auto":
+                    used = str(ds.attrs["linear_solver"])
+                r = row(ds, ne=ne, requested=solver, repeat=k)
+                r["per_sim_s"] = r["wall"] / r["duration"]
+                rows.append(r)
+                print(f"  {ne} elements {solver} ({r['solver']}) #{k}: {r['wall']:.2f} s for "
+                      f"{r['duration']} s, {r['steps']} steps, {r['us_per_res']:.0f} us/res",
+                      file=sys.stderr)
     return rows
+
+
+def _duration_for(ne: int) -> float:
+    """A duration for sizes not in DURATIONS: about the same number of steps as its neighbours
+    (steps per simulated second grow about as the element count)."""
+    return float(min(2.0, 20.0 / ne))
 
 
 # --------------------------------------------------------------------------------- profile
@@ -249,16 +267,34 @@ def fmt_accuracy(res: dict) -> str:
 
 
 def fmt_scaling(rows: list) -> str:
-    lines = ["| elements | unknowns | simulated s | solver (requested -> used) | wall s | "
-             "wall s per simulated s | steps | residuals | Jacobians | ms/residual | "
-             "ms/residual per element |",
-             "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = ["| elements | unknowns | simulated s | solver (requested -> used) | run | wall s | "
+             "CPU s | CPU s per simulated s | steps | residuals | Jacobians | CPU ms/residual | "
+             "CPU ms/residual per element |",
+             "|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         n2 = 2 * 3 * (r["ne"] - 1)
+        cpu_res = 1e3 * r["cpu"] / max(r["nres"], 1)
         lines.append(f"| {r['ne']} | {n2} | {r['duration']:g} | {r['requested']} -> "
-                     f"{r['solver']} | {r['wall']:.2f} | {r['per_sim_s']:.2f} | {r['steps']} | "
-                     f"{r['nres']} | {r['njac']} | {r['us_per_res'] / 1e3:.2f} | "
-                     f"{r['us_per_res'] / 1e3 / r['ne']:.4f} |")
+                     f"{r['solver']} | {r.get('repeat', 0) + 1} | {r['wall']:.2f} | "
+                     f"{r['cpu']:.2f} | {r['cpu'] / r['duration']:.2f} | {r['steps']} | "
+                     f"{r['nres']} | {r['njac']} | {cpu_res:.2f} | {cpu_res / r['ne']:.4f} |")
+    # band against sparse: the fastest run of each (explicit or picked by 'auto')
+    lines += ["", "| elements | 'auto' picks | band: best CPU s | sparse: best CPU s | "
+              "sparse / band (CPU) | band: best wall s | sparse: best wall s | "
+              "sparse / band (wall) |", "|---:|---|---:|---:|---:|---:|---:|---:|"]
+    for ne in sorted({r["ne"] for r in rows}):
+        best = {}
+        for r in rows:
+            if r["ne"] == ne:
+                for k in ("cpu", "wall"):
+                    key = (r["solver"], k)
+                    best[key] = min(best.get(key, np.inf), r[k])
+        auto = next((r["solver"] for r in rows if r["ne"] == ne and r["requested"] == "auto"),
+                    "-")
+        bc, sc = best.get(("band", "cpu"), np.nan), best.get(("sparse", "cpu"), np.nan)
+        bw, sw = best.get(("band", "wall"), np.nan), best.get(("sparse", "wall"), np.nan)
+        lines.append(f"| {ne} | {auto} | {bc:.2f} | {sc:.2f} | {sc / bc:.2f} | {bw:.2f} | "
+                     f"{sw:.2f} | {sw / bw:.2f} |")
     return "\n".join(lines)
 
 
@@ -268,6 +304,13 @@ def main(argv=None):
                     choices=["accuracy", "scaling", "profile", "profile1000", "all"])
     ap.add_argument("--quick", action="store_true", help="fewer runs (a smoke test)")
     ap.add_argument("--json", help="also write the raw numbers here")
+    ap.add_argument("--sizes", help="scaling: element counts, comma separated")
+    ap.add_argument("--solvers", default="auto,band,sparse",
+                    help="scaling: linear solvers, comma separated (default auto,band,sparse)")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="scaling: runs of each solver, interleaved (default 1)")
+    ap.add_argument("--duration-scale", type=float, default=1.0,
+                    help="scaling: multiply the simulated durations by this")
     args = ap.parse_args(argv)
     print(f"Machine: {machine()}\n")
     raw = {}
@@ -277,7 +320,9 @@ def main(argv=None):
         raw["accuracy"] = accuracy(args.quick)
         print(fmt_accuracy(raw["accuracy"]))
     if args.part in ("scaling", "all"):
-        raw["scaling"] = scaling(args.quick)
+        sizes = tuple(int(x) for x in args.sizes.split(",")) if args.sizes else None
+        raw["scaling"] = scaling(args.quick, sizes, tuple(args.solvers.split(",")),
+                                 args.repeat, args.duration_scale)
         print("\n" + fmt_scaling(raw["scaling"]))
     if args.part in ("profile", "all"):
         print("\ncProfile, 16-element cable, 10 s, rtol 1e-6 (tottime):\n")
