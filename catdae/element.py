@@ -526,6 +526,37 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me
         if not np.isfinite(scale):
             scale = l0[e]
         delta = max(1e-5 * min(scale, l0[e]), 1e-12 * l0[e])
+        # the least tension along the element: a perturbation h ± K δ must not reach zero
+        # tension (M_e is not smooth there: the element folds). A free-hanging end sits
+        # exactly at zero tension; its element gets no gradient (∂M/∂c is undefined there).
+        hx = he[0]
+        hy = he[1]
+        vi = he[2]
+        vj = he[2] + w[e] * l0[e]
+        for k in range(ptr[e], ptr[e + 1]):
+            hx -= lf[k, 0]
+            hy -= lf[k, 1]
+            vj -= lf[k, 2]
+        t_i = np.sqrt(he[0] * he[0] + he[1] * he[1] + vi * vi)
+        t_j = np.sqrt(hx * hx + hy * hy + vj * vj)
+        t_min = min(t_i, t_j)
+        if vi * vj < 0.0:
+            t_min = min(t_min, np.sqrt(min(he[0] * he[0] + he[1] * he[1], hx * hx + hy * hy)))
+        t_max = max(t_i, t_j)
+        # ∂M/∂c grows like 1/t_min near a free end and is undefined at zero tension: fade it
+        # out smoothly (C1) between t_min = 1e-3 and 1e-2 of t_max, so that the residual stays
+        # continuous; those elements then follow the paper's M(q) v' form
+        ratio = t_min / t_max if t_max > 0.0 else 0.0
+        if not ratio > 1e-3:
+            continue
+        fade = 1.0
+        if ratio < 1e-2:
+            xf = np.log10(ratio) + 3.0  # 0 .. 1
+            fade = xf * xf * (3.0 - 2.0 * xf)
+        for k in range(3):
+            kc = np.sqrt(kmat[e, 0, k] ** 2 + kmat[e, 1, k] ** 2 + kmat[e, 2, k] ** 2)
+            if kc * delta > 0.25 * t_min:
+                delta = 0.25 * t_min / kc
         for k in range(3):
             for sgn in (1.0, -1.0):
                 for m in range(3):
@@ -541,7 +572,7 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me
                           gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
                 for r in range(6):
                     for c in range(6):
-                        dout[e, k, r, c] += sgn * mt[r, c] / (2.0 * delta)
+                        dout[e, k, r, c] += fade * sgn * mt[r, c] / (2.0 * delta)
 
 
 @njit(cache=True)
