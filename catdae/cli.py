@@ -139,6 +139,8 @@ def summary(tree) -> str:
             lines.append(f"    largest motion at node {node}: "
                          f"{float(mag.sel(node=node).max()):.4g} m; "
                          f"max tension {float(ds.tension.max()):.6g} N")
+            if a.get("note"):
+                lines.append(f"    note: {a['note']}")
     return "\n".join(lines)
 
 

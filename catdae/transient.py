@@ -135,6 +135,7 @@ class TransientProblem:
         self._support_t = None
         self.n_res = 0
         self.n_jac = 0
+        self.velocity_jumps: list[tuple[float, float]] = []  # (t, largest |Δv_s| m/s)
         self.n_rejected = 0
 
     # ------------------------------------------------------------------ pieces
@@ -326,6 +327,8 @@ class TransientProblem:
         mdata = self.mass_data(conf)
         mff = self.ff(mdata).tocsc()
         dvs = self._supports(t0)[1] - vs_before
+        if np.any(dvs):
+            self.velocity_jumps.append((float(t0), float(np.abs(dvs).max())))
         v0 = np.array(v0, float)
         if np.any(dvs) and m.mass_model != "lumped":
             full = m.pattern.matrix(mdata)
@@ -475,7 +478,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "paper" if model.mass_model == "consistent" else "constant mass",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
-            "n_outputs": n_valid, "n_restarts": n_restarts,
+            "n_outputs": n_valid, "n_restarts": n_restarts, "note": _note(model, prob),
         }
         return results.transient_dataset(model.mesh, times[sl], out_X[sl], out_V[sl],
                                           out_A[sl], out_T[sl], out_R[sl], energy, attrs)
@@ -551,6 +554,17 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     state.h = prob.h
     state.t = t_end
     return ds
+
+
+def _note(model: Model, prob: TransientProblem) -> str:
+    """Advice on the result's accuracy that the run itself found ("" when none)."""
+    if model.mass_model != "consistent" or not prob.velocity_jumps:
+        return ""
+    t, dv = prob.velocity_jumps[0]
+    return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "
+            "(water-hammer) wave it sends is not carried by the consistent catenary mass of "
+            "slack elements; tensions may be underestimated (try mass_model = \"lumped\" or "
+            "\"linear\"; README, Accuracy and known limits)")
 
 
 def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:

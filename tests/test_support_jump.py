@@ -223,3 +223,15 @@ def test_velocity_jump_sends_a_water_hammer_wave_linear(tmp_path):
 def test_velocity_jump_sends_a_water_hammer_wave_consistent(tmp_path):
     ds, c, jump = _water_hammer(tmp_path, "consistent", 50)
     _check_water_hammer(ds, c, jump, 50)
+
+
+def test_a_velocity_jump_with_the_consistent_mass_leaves_a_note(tmp_path):
+    """The run says when its own accuracy is in doubt: a support velocity jump (0.03π m/s) with
+    the consistent mass; no note with the lumped mass, which carries the wave."""
+    path = _case(tmp_path, "short", duration=0.05)
+    for mm, expect in (("consistent", True), ("lumped", False)):
+        ds = catdae.run(path, elements=10, mass_model=mm, progress=False)["excitation"].ds
+        note = ds.attrs["note"]
+        assert bool(note) is expect, note
+        if expect:
+            assert "0.0942 m/s" in note and "lumped" in note
