@@ -254,6 +254,22 @@ class Model:
         return np.bincount(self.edofs.ravel(), weights=r.reshape(-1),
                            minlength=self.n_dof)
 
+    def element_lambda2(self, state: ElementState, X: np.ndarray) -> np.ndarray:
+        """Irvine's λ² of each element from its stiffness along the chord, (n_elem,).
+
+        Ernst's equivalent modulus, EA_eq = EA / (1 + λ²/12), read backwards: λ² = 12
+        (EA / (L0 k_cc) - 1) with k_cc = ĉᵀ K ĉ. λ² ≪ 1: the element takes a change of chord by
+        stretch (a bar); λ² ≫ 1: by sag (inf for a slack element, K = 0).
+        """
+        c = self.chords(X)
+        n = np.linalg.norm(c, axis=1)
+        u = c / np.where(n > 0, n, 1.0)[:, None]
+        kcc = np.einsum("ei,eij,ej->e", u, state.K, u)
+        with np.errstate(divide="ignore"):
+            ratio = np.where(kcc > 0, self.mesh.EA / (self.mesh.L0 * np.maximum(kcc, 1e-300)),
+                             np.inf)
+        return np.maximum(12.0 * (ratio - 1.0), 0.0)
+
     def stiffness_data(self, state: ElementState) -> np.ndarray:
         """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``)."""
         return self.pattern.assemble(state.stiffness6)

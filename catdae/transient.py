@@ -135,7 +135,8 @@ class TransientProblem:
         self._support_t = None
         self.n_res = 0
         self.n_jac = 0
-        self.velocity_jumps: list[tuple[float, float]] = []  # (t, largest |Δv_s| m/s)
+        # (t, largest |Δv_s| m/s, largest element λ²) of each support velocity jump
+        self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
 
     # ------------------------------------------------------------------ pieces
@@ -328,7 +329,9 @@ class TransientProblem:
         mff = self.ff(mdata).tocsc()
         dvs = self._supports(t0)[1] - vs_before
         if np.any(dvs):
-            self.velocity_jumps.append((float(t0), float(np.abs(dvs).max())))
+            lam2 = m.element_lambda2(conf[0], self.X.reshape(-1, 3))
+            self.velocity_jumps.append((float(t0), float(np.abs(dvs).max()),
+                                        float(lam2.max())))
         v0 = np.array(v0, float)
         if np.any(dvs) and m.mass_model != "lumped":
             full = m.pattern.matrix(mdata)
@@ -558,13 +561,15 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
 
 def _note(model: Model, prob: TransientProblem) -> str:
     """Advice on the result's accuracy that the run itself found ("" when none)."""
-    if model.mass_model != "consistent" or not prob.velocity_jumps:
+    jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
+    if model.mass_model != "consistent" or not jumps:
         return ""
-    t, dv = prob.velocity_jumps[0]
+    t, dv, lam2 = jumps[0]
     return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "
             "(water-hammer) wave it sends is not carried by the consistent catenary mass of "
-            "slack elements; tensions may be underestimated (try mass_model = \"lumped\" or "
-            "\"linear\"; README, Accuracy and known limits)")
+            f"elements that take a chord change by sag (element λ² up to {lam2:.3g} here, "
+            "> 1); tensions may be underestimated (try mass_model = \"lumped\" or \"linear\", "
+            "or more elements; README, Accuracy and known limits)")
 
 
 def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:

@@ -235,3 +235,51 @@ def test_a_velocity_jump_with_the_consistent_mass_leaves_a_note(tmp_path):
         assert bool(note) is expect, note
         if expect:
             assert "0.0942 m/s" in note and "lumped" in note
+
+
+@pytest.mark.parametrize("L0", [100.05, 100.2, 100.8])
+def test_element_lambda2_matches_irvine(L0):
+    """The λ² behind the note, from the element stiffness along the chord (Ernst), equals
+    Irvine's λ² = (w l / H)² l / (H L_e / EA), L_e = l (1 + 8 (d/l)²), for a shallow span."""
+    from catdae.assembly import Model
+    from catdae.mesh import build_mesh
+
+    text = GENTLE.split("[[support_motions]]")[0].replace("length = 15.0", f"length = {L0}")
+    text = text.replace("B = [10.0, 0.0, 0.0]", "B = [100.0, 0.0, 0.0]").replace(
+        "elements = 10", "elements = 1")
+    case = catdae.load_case(text)
+    mesh = build_mesh(case)
+    model = Model(case, mesh, set())
+    state = model.element_state(mesh.X0)
+    w, ea, span = 5.0 * 9.81, 3.4e7, 100.0
+    H = abs(float(state.h[0, 0]))
+    sag = w * span**2 / (8 * H)
+    le = span * (1 + 8 * (sag / span) ** 2)
+    irvine = (w * span / H) ** 2 * span / (H * le / ea)
+    assert model.element_lambda2(state, mesh.X0)[0] == pytest.approx(irvine, rel=0.02)
+
+
+def test_no_note_when_the_elements_are_bars(tmp_path):
+    """A taut cable (element λ² about 0.1 at 50 elements) carries the axial wave with the
+    consistent mass too (tension jump m c Δv_t within 10 %): no note."""
+    text = VIOLENT.replace("length = 15.0", "length = 10.01").replace(
+        "duration = 4.0", "duration = 0.002").replace(
+        "output_interval = 0.01", "output_interval = 0.0001").replace(
+        'mass_model = "lumped"', 'mass_model = "consistent"')
+    for old, new in (("amplitude = 3.0", "amplitude = 0.003"),
+                     ("amplitude = -3.0", "amplitude = -0.003"),
+                     ("offset = 3.0", "offset = 0.003")):
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / "taut.toml"
+    path.write_text(text)
+    tree = catdae.run(path, elements=50, progress=False)
+    ds = tree["excitation"].ds
+    assert ds.attrs["note"] == ""
+    reaction = tree["initial"].ds.reaction.sel(node="A").values
+    dvt = 0.003 * np.pi * reaction[2] / np.linalg.norm(reaction)
+    jump = 5.0 * np.sqrt(3.4e7 / 5.0) * dvt
+    t = ds.time.values
+    tension = ds.tension.sel(end="i").values
+    window = (t >= 0.0003) & (t <= 0.0015)
+    assert tension[window, 0].mean() - tension[0, 0] == pytest.approx(jump, rel=0.1)
