@@ -1,0 +1,101 @@
+"""Errors of the runs against the reference, and the study's labelled Dataset."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from ..case import Step
+from .core import _CHOICES, _COORD_META, _COUNTS, _MEMORY_NAMES
+
+
+def _motion(ref: xr.Dataset, label: str) -> float:
+    return float(np.linalg.norm(ref.displacement.sel(point=label).values, axis=1).max())
+
+
+def _transient_error(run_ds: xr.Dataset, ref: xr.Dataset, label: str) -> float:
+    """max over the reference's output times of |u_run - u_ref| at the point, m."""
+    t_ref = ref.time.values
+    t = run_ds.time.values
+    u_ref = ref.displacement.sel(point=label).values  # (n_t_ref, 3) m
+    u = run_ds.displacement.sel(point=label).values  # (n_t, 3) m
+    span = max(abs(t_ref[-1]), 1.0) * 1e-9
+    inside = (t_ref >= t[0] - span) & (t_ref <= t[-1] + span)
+    if not inside.any():
+        return math.nan
+    ui = np.column_stack([np.interp(t_ref[inside], t, u[:, a]) for a in range(u.shape[1])])
+    return float(np.linalg.norm(ui - u_ref[inside], axis=1).max())
+
+
+def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
+    names = list(grid)
+    shape = tuple(len(v) for v in grid.values())
+    data = {v: np.full(shape, np.nan) for v in ("wall_time", *_COUNTS, "peak_memory", "error")}
+    status = np.full(shape, "", dtype=object)
+    ref_ok = ref.attrs.get("status", "completed") == "completed"
+    if st.kind == "transient":
+        if isinstance(target, list):  # the common point that moves most in the reference
+            target = max(target, key=lambda p: _motion(ref, p)) if ref_ok else target[0]
+        label = target
+    else:
+        n_modes = target
+        ref_f = ref.frequency.values[:n_modes] if ref_ok else np.full(n_modes, np.nan)
+        ferr = np.full((*shape, n_modes), np.nan)
+    for combo, key in zip(combos, keys, strict=True):
+        idx = tuple(grid[n].index(combo[n]) for n in names)
+        rec = records[key]
+        status[idx] = str(rec.attrs["status"])
+        for v in ("wall_time", *_COUNTS, "peak_memory"):
+            data[v][idx] = float(rec.attrs.get(v, math.nan))
+        if status[idx] != "completed" or not ref_ok:
+            continue
+        if st.kind == "transient":
+            data["error"][idx] = _transient_error(rec, ref, label)
+        else:
+            f = rec.frequency.values[:n_modes]
+            ferr[idx][: f.size] = (f - ref_f[: f.size]) / ref_f[: f.size]
+            data["error"][idx] = float(np.nanmax(np.abs(ferr[idx])))
+    dims = tuple(names)
+    coords = {}
+    for n in names:
+        vals = np.array(grid[n], dtype=object if n in _CHOICES else None)
+        coords[n] = xr.Variable(n, vals, {"units": _COORD_META[n][0],
+                                          "long_name": _COORD_META[n][1]})
+    methods = sorted({str(r.attrs.get("memory_method", "")) for r in records.values()} - {""})
+    memory = "+".join(methods)
+    mem_name = "; ".join(_MEMORY_NAMES[m] for m in methods)
+    if st.kind == "transient":
+        err_units, err_name = "m", (f"largest distance over time between the displacement at "
+                                    f"{label} and the reference's")
+    else:
+        err_units, err_name = "1", (f"largest relative error of the {n_modes} lowest natural "
+                                    "frequencies")
+    meta = {
+        "wall_time": ("s", "wall time of the study step (warm worker)"),
+        "n_steps": ("1", "IDA internal steps"),
+        "n_residual_evaluations": ("1", "residual evaluations"),
+        "n_jacobian_evaluations": ("1", "iteration matrix evaluations"),
+        "peak_memory": ("B", mem_name),
+        "error": (err_units, err_name),
+    }
+    variables = {v: xr.Variable(dims, data[v], {"units": u, "long_name": ln})
+                 for v, (u, ln) in meta.items()}
+    variables["status"] = xr.Variable(dims, status, {"units": "1", "long_name": "run status "
+                                                     "('completed' or why it stopped)"})
+    out = xr.Dataset(variables, coords=coords)
+    if st.kind == "modal":
+        out = out.assign_coords(mode=xr.Variable("mode", np.arange(1, n_modes + 1),
+                                                 {"long_name": "mode number"}))
+        out["frequency_error"] = xr.Variable(
+            (*dims, "mode"), ferr, {"units": "1", "long_name": "relative error of the natural "
+                                    "frequency (f - f_ref) / f_ref"})
+        out.attrs["response"] = f"{n_modes} lowest natural frequencies"
+        out.attrs["error_definition"] = "max over the modes of |f - f_ref| / f_ref"
+    else:
+        out.attrs["response"] = label
+        out.attrs["error_definition"] = (f"max over the reference's output times of |u_run - "
+                                         f"u_ref| at {label}, linear interpolation in time")
+    out.attrs["peak_memory_method"] = memory
+    return out

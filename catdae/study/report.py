@@ -1,0 +1,50 @@
+"""A study's outputs: the netCDF file and its plots (:func:`write_study`), and the text
+summary (:func:`summary`)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import xarray as xr
+
+from .core import SETTINGS
+from .plots import plot_convergence, plot_work_precision
+
+
+def write_study(ds: xr.Dataset, path: str | os.PathLike, plots: bool = True) -> list[Path]:
+    """The Dataset to netCDF (atomically) and, with ``plots``, ``<stem>-work-precision.png``
+    and ``<stem>-convergence.png`` beside it. Returns the files written."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    written = [path]
+    if plots:
+        wp = path.with_name(f"{path.stem}-work-precision.png")
+        plot_work_precision(ds, wp)
+        written.append(wp)
+        conv = path.with_name(f"{path.stem}-convergence.png")
+        if plot_convergence(ds, conv) is not None:
+            written.append(conv)
+    return written
+
+
+def summary(ds: xr.Dataset) -> str:
+    """One line per run: its swept settings, cost and error."""
+    swept = [d for d in SETTINGS if d in ds.dims and ds.sizes[d] > 1]
+    lines = [f"study of step '{ds.attrs['step']}' of {ds.attrs['case_name']}: response "
+             f"{ds.attrs['response']}; reference {ds.attrs['reference']}"]
+    flat = ds.drop_vars([v for v in ("frequency_error",) if v in ds]).stack(run=list(
+        d for d in SETTINGS if d in ds.dims))
+    for i in range(flat.sizes["run"]):
+        r = flat.isel(run=i)
+        what = ", ".join(f"{d}={r[d].item()}" for d in swept) or "run"
+        lines.append(f"  {what}: {r.status.item()}, {float(r.wall_time):.3g} s, "
+                     f"{float(r.n_residual_evaluations):.0f} residuals, error "
+                     f"{float(r.error):.3g} {ds.error.attrs['units']}")
+    return "\n".join(lines)

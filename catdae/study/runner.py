@@ -1,0 +1,238 @@
+"""The study itself: :func:`run_study` builds the grid and the reference, executes the runs
+not yet stored (here or on a Dask cluster) and assembles the Dataset."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import sys
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import ExitStack
+from dataclasses import replace
+from datetime import UTC, datetime
+from pathlib import Path
+
+import xarray as xr
+
+from .. import __version__
+from ..analysis import as_case
+from ..case import AXES, Case, Step
+from ..errors import CaseError
+from .core import (
+    _COUNTS,
+    StudyError,
+    _common_points,
+    _resolve_response,
+    configure,
+    point_labels,
+    reference_settings,
+    run_key,
+    settings_grid,
+    study_step,
+)
+from .dataset import _assemble
+from .store import _clean, _store_read, _store_write
+from .worker import _MemoryProbe
+
+
+def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
+              rtol: Sequence[float] | None = None, atol: Sequence[float] | None = None,
+              elements: Sequence[int] | None = None, gauss_points: Sequence[int] | None = None,
+              mass_model: Sequence[str] | None = None, linear_solver: Sequence[str] | None = None,
+              max_order: Sequence[int] | None = None, response: str | int | None = None,
+              reference: Mapping | xr.Dataset | xr.DataTree | None = None, scheduler=None,
+              store: str | os.PathLike | None = None, duration: float | None = None,
+              workers: int = 2, memory: str = "rss",
+              on_run: Callable[[dict, xr.Dataset], None] | None = None) -> xr.Dataset:
+    """Run the study step of ``case`` over the grid of settings; see the package docstring.
+
+    ``case``: a Case, a path or TOML text. Each setting is a list (None: the case's value).
+    ``scheduler``: None (a local cluster of ``workers`` processes), ``"synchronous"`` (here, in
+    turn), a scheduler address such as ``"tcp://10.0.0.5:8786"``, or a ``distributed.Client``.
+    ``store``: folder of finished runs (None: keep nothing). ``duration`` shortens or lengthens a
+    transient study step. ``on_run(settings, run)`` is called as each run finishes (settings is
+    None for the reference). Returns the Dataset (dimensions: the settings of the step's kind).
+    """
+    case = as_case(case)
+    st = study_step(case, step)
+    if duration is not None and not (st.kind == "transient" and 0 < duration < math.inf):
+        raise StudyError(f"duration: expected a number > 0 for a transient step, found "
+                         f"{duration!r} ({st.kind} step {st.name!r})")
+    grid = settings_grid(case, st, {"rtol": rtol, "atol": atol, "elements": elements,
+                                    "gauss_points": gauss_points, "mass_model": mass_model,
+                                    "linear_solver": linear_solver, "max_order": max_order})
+    names = list(grid)
+    combos = [dict(zip(names, vals, strict=True)) for vals in itertools.product(*grid.values())]
+    try:
+        run_cases = [configure(case, st.name, s, duration) for s in combos]
+        given_ref = isinstance(reference, xr.Dataset | xr.DataTree)
+        ref_settings = None if given_ref else reference_settings(grid, reference)
+        ref_case = None if given_ref else configure(case, st.name, ref_settings, duration)
+    except CaseError as exc:
+        raise StudyError(f"a setting of the study makes the case invalid:\n{exc}") from None
+    _MemoryProbe(memory)  # reject an unknown method before anything runs
+    keys = [run_key(c, st.name, memory) for c in run_cases]
+    ref_data = _given_reference(reference, st, case) if given_ref else None
+    if st.kind == "transient":
+        given_points = set(ref_data.point.values) if given_ref else None
+        target = _transient_target(case, run_cases + ([ref_case] if ref_case else []), response,
+                                   grid, given_points)
+    else:
+        target = _modal_target(st, response)
+    ref_key = None if given_ref else run_key(ref_case, st.name, memory)
+
+    store_dir = Path(store) if store is not None else None
+    if store_dir is not None:
+        store_dir.mkdir(parents=True, exist_ok=True)
+    records: dict[str, xr.Dataset] = {}
+    todo: dict[str, Case] = {}
+    for key, c in ([(ref_key, ref_case)] if ref_key else []) + list(zip(keys, run_cases,
+                                                                          strict=True)):
+        stored = _store_read(store_dir, key) if store_dir is not None else None
+        if stored is not None:
+            records[key] = stored
+        else:
+            todo[key] = c
+    by_key = dict(zip(keys, combos, strict=True))
+    for key, ds in _execute_all(todo, st.name, memory, scheduler, workers):
+        if store_dir is not None and not ds.attrs.get("lost"):
+            _store_write(store_dir, key, ds, by_key.get(key, ref_settings))
+        records[key] = ds
+        if on_run is not None:
+            on_run(by_key.get(key), ds)
+    ref = ref_data if ref_data is not None else records[ref_key]
+    out = _assemble(grid, combos, keys, records, ref, st, target)
+    out.attrs.update(_clean({
+        "title": case.title, "case_name": case.name, "step": st.name, "step_kind": st.kind,
+        "duration": duration if duration is not None else st.duration,
+        "catdae_version": __version__, "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "scheduler": _scheduler_name(scheduler, workers), "store": str(store_dir or ""),
+        "n_runs": len(combos), "n_runs_computed": len(todo) - (ref_key in todo),
+        "Conventions": "CF-1.10",
+    }))
+    if given_ref:
+        out.attrs["reference"] = "given by the user"
+    else:
+        out.attrs["reference"] = ", ".join(f"{k}={v}" for k, v in ref_settings.items())
+        out.attrs.update({f"reference_{k}": v for k, v in ref_settings.items()})
+    out.attrs["reference_status"] = str(ref.attrs.get("status", "completed"))
+    if not given_ref:
+        out.attrs["reference_wall_time"] = float(ref.attrs["wall_time"])
+    return out
+
+
+def _transient_target(case: Case, run_cases: list[Case], response, grid,
+                      given_points: set[str] | None) -> str | list[str]:
+    """The response point, or the candidates when the reference is to choose (package doc)."""
+    common = _common_points(run_cases)
+    if given_points is not None:
+        common &= given_points
+    if response is not None:
+        label = _resolve_response(str(response), case)
+        if label not in common:
+            raise StudyError(f"response {response!r} ({label}) is not a node of every mesh of "
+                             f"the study (elements {grid['elements']} and the reference); "
+                             f"common points: {', '.join(sorted(common)) or 'none'}")
+        return label
+    if not common:
+        raise StudyError(
+            f"no node is common to every mesh of the study (elements {grid['elements']} and the "
+            "reference): choose element counts with a common factor (with all counts even the "
+            "midspan node is shared) or a case with a free named node")
+    return sorted(common)
+
+
+def _modal_target(st: Step, response) -> int:
+    if response is None:
+        return int(st.modes)
+    try:
+        n = int(response)
+    except (TypeError, ValueError):
+        n = 0
+    if not 1 <= n <= st.modes:
+        raise StudyError(f"response of a modal study: expected the number of modes compared, "
+                         f"1 to {st.modes}, found {response!r}")
+    return n
+
+
+def _given_reference(reference, st: Step, case: Case) -> xr.Dataset:
+    """A user's reference results (a step group, or a tree holding it) in the stored form."""
+    ds = reference
+    if isinstance(ds, xr.DataTree):
+        if st.name not in ds.children:
+            raise StudyError(f"reference: the results have no group {st.name!r}")
+        ds = ds[st.name].to_dataset()
+    attrs = {"status": str(ds.attrs.get("status", "completed")), "wall_time": math.nan}
+    if st.kind == "modal":
+        if "frequency" not in ds:
+            raise StudyError("reference: a modal study needs a 'frequency' variable")
+        return xr.Dataset({"frequency": ("mode", ds.frequency.values)}, attrs=attrs)
+    if "displacement" not in ds:
+        raise StudyError("reference: a transient study needs a 'displacement' variable")
+    names = [str(n) for n in ds.node.values]
+    counts: dict[str, int] = {}
+    for n in names:
+        if n not in case.nodes:
+            cable = n.rpartition(".")[0]
+            counts[cable] = counts.get(cable, 1) + 1
+    ref_case = replace(case, cables=tuple(replace(c, elements=counts.get(c.name, 1))
+                                          for c in case.cables))
+    labels = point_labels(ref_case, names)
+    keep = [i for i, lab in enumerate(labels) if lab is not None]
+    return xr.Dataset(
+        {"displacement": (("time", "point", "axis"), ds.displacement.values[:, keep])},
+        coords={"time": ds.time.values, "point": [labels[i] for i in keep], "axis": list(AXES)},
+        attrs=attrs)
+
+
+def _execute_all(todo: Mapping[str, Case], step_name: str, memory: str, scheduler,
+                 workers: int) -> Iterator[tuple[str, xr.Dataset]]:
+    """Yield (key, run) as runs finish. A task that failed outside catdae (a lost worker, a bug)
+    yields a run with status 'error: ...' and attr ``lost``, which is not stored."""
+    if not todo:
+        return
+    if scheduler == "synchronous":
+        for key, c in todo.items():
+            yield key, _package().execute(c, step_name, memory)
+        return
+    from distributed import Client, LocalCluster, as_completed
+
+    with ExitStack() as stack:
+        if isinstance(scheduler, Client):
+            client = scheduler
+        elif scheduler is None:
+            cluster = stack.enter_context(LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                dashboard_address=None))
+            client = stack.enter_context(Client(cluster))
+        else:
+            client = stack.enter_context(Client(scheduler))
+        futures = {client.submit(_package().execute, c, step_name, memory, pure=False): key
+                   for key, c in todo.items()}
+        for fut in as_completed(futures):
+            key = futures[fut]
+            try:
+                ds = fut.result()
+            except Exception as exc:  # any remote failure (lost worker, bug) becomes a status
+                ds = xr.Dataset(attrs={"status": f"error: {type(exc).__name__}: {exc}",
+                                       "lost": 1, "wall_time": math.nan,
+                                       "peak_memory": math.nan,
+                                       **{k: math.nan for k in _COUNTS}})
+            fut.release()
+            yield key, ds
+
+
+def _scheduler_name(scheduler, workers: int) -> str:
+    if scheduler is None:
+        return f"distributed.LocalCluster(n_workers={workers}, threads_per_worker=1, processes)"
+    if isinstance(scheduler, str):
+        return scheduler
+    return str(getattr(getattr(scheduler, "scheduler", None), "address", scheduler))
+
+
+def _package():
+    """``catdae.study`` itself. :func:`_execute_all` calls the task as ``catdae.study.execute``,
+    looked up when it runs, so that replacing that attribute (as the tests do with monkeypatch)
+    replaces the task, as it did when the study was one module."""
+    return sys.modules[__package__]

@@ -1,0 +1,50 @@
+"""The resumable store: one netCDF file per finished run, ``<store>/<key>.nc``, written
+atomically, so that a rerun skips what is stored."""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .core import STORE_FORMAT
+
+
+def _store_read(store: Path, key: str) -> xr.Dataset | None:
+    path = store / f"{key}.nc"
+    if not path.exists():
+        return None
+    try:
+        ds = xr.load_dataset(path, engine="netcdf4")
+    except (OSError, ValueError):
+        return None  # unreadable: computed again
+    if ds.attrs.get("key") != key or ds.attrs.get("store_format") != STORE_FORMAT:
+        return None
+    return ds
+
+
+def _store_write(store: Path, key: str, ds: xr.Dataset, settings: Mapping | None) -> None:
+    """Atomically: a temporary file moved into place, so a crash never leaves half a run."""
+    out = ds.copy()
+    out.attrs.update(key=key, store_format=STORE_FORMAT,
+                     settings=json.dumps({k: _plain(v) for k, v in (settings or {}).items()}))
+    path = store / f"{key}.nc"
+    tmp = store / f".{key}.nc.tmp{os.getpid()}"
+    try:
+        out.to_netcdf(tmp, engine="netcdf4")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def _plain(v):
+    return v.item() if isinstance(v, np.generic) else v
+
+
+def _clean(attrs: dict) -> dict:
+    return {k: _plain(v) for k, v in attrs.items() if v is not None}
