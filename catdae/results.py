@@ -145,17 +145,23 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 
 
-def write_tree(tree: xr.DataTree, path: str | os.PathLike) -> Path:
-    """Write netCDF-4 with groups atomically: a temporary file moved over the target."""
+def write_atomic(data: xr.DataTree | xr.Dataset, path: str | os.PathLike) -> Path:
+    """Write netCDF-4 atomically: a temporary file beside the target, moved over it, so that a
+    crash never leaves half a file and an existing file is only replaced by a complete one."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     try:
-        tree.to_netcdf(tmp, engine="netcdf4")
+        data.to_netcdf(tmp, engine="netcdf4")
         os.replace(tmp, path)
     finally:
         if tmp.exists():
             tmp.unlink()
     return path
+
+
+def write_tree(tree: xr.DataTree, path: str | os.PathLike) -> Path:
+    """Write netCDF-4 with groups atomically (see :func:`write_atomic`)."""
+    return write_atomic(tree, path)
 
 
 def read_tree(path: str | os.PathLike) -> xr.DataTree:

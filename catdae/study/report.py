@@ -8,6 +8,7 @@ from pathlib import Path
 
 import xarray as xr
 
+from ..results import write_atomic
 from .core import SETTINGS
 from .plots import plot_convergence, plot_work_precision
 
@@ -15,14 +16,7 @@ from .plots import plot_convergence, plot_work_precision
 def write_study(ds: xr.Dataset, path: str | os.PathLike, plots: bool = True) -> list[Path]:
     """The Dataset to netCDF (atomically) and, with ``plots``, ``<stem>-work-precision.png``
     and ``<stem>-convergence.png`` beside it. Returns the files written."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    try:
-        ds.to_netcdf(tmp, engine="netcdf4")
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+    path = write_atomic(ds, path)
     written = [path]
     if plots:
         wp = path.with_name(f"{path.stem}-work-precision.png")

@@ -4,13 +4,13 @@ atomically, so that a rerun skips what is stored."""
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from ..results import write_atomic
 from .core import STORE_FORMAT
 
 
@@ -32,14 +32,7 @@ def _store_write(store: Path, key: str, ds: xr.Dataset, settings: Mapping | None
     out = ds.copy()
     out.attrs.update(key=key, store_format=STORE_FORMAT,
                      settings=json.dumps({k: _plain(v) for k, v in (settings or {}).items()}))
-    path = store / f"{key}.nc"
-    tmp = store / f".{key}.nc.tmp{os.getpid()}"
-    try:
-        out.to_netcdf(tmp, engine="netcdf4")
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+    write_atomic(out, store / f"{key}.nc")
 
 
 def _plain(v):
