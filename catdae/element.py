@@ -84,11 +84,12 @@ def _segment(hx, hy, v, w, ea, a, b, d, f, want_flex):
     ub = v + w * b
     ta = np.sqrt(h2 + ua * ua)
     tb = np.sqrt(h2 + ub * ub)
-    if ua * ub >= 0.0:
+    # comparisons on real parts: the same code runs on complex tensions (complex-step ∂M/∂c)
+    if (ua * ub).real >= 0.0:
         s_ = h2 + ta * tb + ua * ub
     else:
         s_ = h2 * (1.0 + (h2 + ua * ua + ub * ub) / (ta * tb - ua * ub))
-    if not (ta > 0.0 and tb > 0.0 and s_ > 0.0):
+    if not (ta.real > 0.0 and tb.real > 0.0 and s_.real > 0.0):
         return False
     r = (ta + tb) / s_
     le = ell / ea
@@ -147,7 +148,7 @@ def _inv_sym3(f, kout):
     c12 = b * c - a * e
     c22 = a * d - b * b
     det = a * c00 + b * c01 + c * c02
-    if not (det > 0.0) or not np.isfinite(det):
+    if not (det.real > 0.0) or not np.isfinite(det.real):
         return False
     inv = 1.0 / det
     kout[0, 0] = c00 * inv
@@ -412,7 +413,7 @@ def _tension_batch(h, w, ptr, ls, lf, s, tout):
 @njit(cache=True, inline="always")
 def _add_ntn(g6, kk, frac, slack, scale, out):
     """out (6, 6) += scale * NᵀN with N = [I - B, B], B = G K (§6); slack: B = frac I."""
-    b = np.empty((3, 3))
+    b = np.empty((3, 3), out.dtype)
     if slack:
         for r in range(3):
             for c in range(3):
@@ -496,39 +497,31 @@ def _mass_batch(h, kmat, stat, l0, ea, w, ptr, ls, lf, gs, gw, mq, pmptr, pms, p
 @njit(cache=True)
 def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me, gs, gw, mq,
                          pmptr, pms, pmm, dout):
-    """∂M_e/∂c_k (n, 3, 6, 6) by central differences of the chord c = x_j - x_i.
+    """∂M_e/∂c_k (n, 3, 6, 6) by complex steps along the chord c = x_j - x_i.
 
-    M_e depends on the nodes only through the chord. The step δ is 1e-5 of |F h| (the chord
-    change that alters the tension by its own size), so it suits taut and slack elements
-    alike; the perturbed tensions are the linear predictions h ± K δ e_k (their O(δ²) errors
-    cancel to O(δ³) in the difference), and F, K and M_e are evaluated there exactly. Central
-    differences keep the round-off noise near eps/δ = 1e-11 relative: forward differences with a
-    smaller step left 1e-9 of noise in the residual, which made IDA take 90 times more steps at
-    rtol 1e-10. Slack elements (straight-line interpolation, constant M_e) get zero.
+    M_e depends on the nodes only through the chord, and on the chord through h (∂h/∂c = K):
+    ∂M_e/∂c_k = Im M_e(h + i δ K e_k) / δ, with F, K = F⁻¹ and M_e evaluated by the same
+    (analytic) formulas in complex arithmetic. No difference is taken, so the derivative is
+    exact to round-off for any small δ: no truncation error and no cancellation noise (central
+    differences left about 1e-11 of noise, which made IDA take more steps at tight
+    tolerances). Slack elements (straight-line interpolation, constant M_e) get zero.
     """
-    x = np.empty(3)
-    g6 = np.empty(6)
-    d = np.empty(3)
-    f6 = np.empty(6)
-    kk = np.empty((3, 3))
-    ht = np.empty(3)
-    mt = np.empty((6, 6))
+    x = np.empty(3, np.complex128)
+    g6 = np.empty(6, np.complex128)
+    d = np.empty(3, np.complex128)
+    f6 = np.empty(6, np.complex128)
+    kk = np.empty((3, 3), np.complex128)
+    ht = np.empty(3, np.complex128)
+    mt = np.empty((6, 6), np.complex128)
     for e in range(chord.shape[0]):
         dout[e, :, :, :] = 0.0
         if stat[e] != CONVERGED:
             continue
-        fe = fflat[e]
         he = h[e]
-        fh0 = fe[0] * he[0] + fe[1] * he[1] + fe[2] * he[2]
-        fh1 = fe[1] * he[0] + fe[3] * he[1] + fe[4] * he[2]
-        fh2 = fe[2] * he[0] + fe[4] * he[1] + fe[5] * he[2]
-        scale = np.sqrt(fh0 * fh0 + fh1 * fh1 + fh2 * fh2)
-        if not np.isfinite(scale):
-            scale = l0[e]
-        delta = max(1e-5 * min(scale, l0[e]), 1e-12 * l0[e])
-        # the least tension along the element: a perturbation h ± K δ must not reach zero
-        # tension (M_e is not smooth there: the element folds). A free-hanging end sits
-        # exactly at zero tension; its element gets no gradient (∂M/∂c is undefined there).
+        # the least tension along the element: ∂M/∂c grows like 1/t_min near a free end and
+        # is undefined at zero tension; fade it out smoothly (C1) between t_min = 1e-2 and
+        # 1e-3 of t_max, so that the residual stays continuous; those elements then follow
+        # the paper's M(q) v' form
         hx = he[0]
         hy = he[1]
         vi = he[2]
@@ -543,9 +536,6 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me
         if vi * vj < 0.0:
             t_min = min(t_min, np.sqrt(min(he[0] * he[0] + he[1] * he[1], hx * hx + hy * hy)))
         t_max = max(t_i, t_j)
-        # ∂M/∂c grows like 1/t_min near a free end and is undefined at zero tension: fade it
-        # out smoothly (C1) between t_min = 1e-3 and 1e-2 of t_max, so that the residual stays
-        # continuous; those elements then follow the paper's M(q) v' form
         ratio = t_min / t_max if t_max > 0.0 else 0.0
         if not ratio > 1e-3:
             continue
@@ -555,24 +545,20 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me
             fade = xf * xf * (3.0 - 2.0 * xf)
         for k in range(3):
             kc = np.sqrt(kmat[e, 0, k] ** 2 + kmat[e, 1, k] ** 2 + kmat[e, 2, k] ** 2)
-            if kc * delta > 0.25 * t_min:
-                delta = 0.25 * t_min / kc
-        for k in range(3):
-            for sgn in (1.0, -1.0):
-                for m in range(3):
-                    ht[m] = he[m] + sgn * delta * kmat[e, m, k]
-                ok = _partial(ht[0], ht[1], ht[2], w[e], ea[e], l0[e], ls, lf, ptr[e],
-                              ptr[e + 1], d, f6, True)
-                if not ok or not _inv_sym3(f6, kk):
-                    for r in range(6):
-                        for c in range(6):
-                            dout[e, k, r, c] = 0.0
-                    break
-                _mass_one(ht, kk, False, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], gs[e],
-                          gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
-                for r in range(6):
-                    for c in range(6):
-                        dout[e, k, r, c] += fade * sgn * mt[r, c] / (2.0 * delta)
+            if not (kc > 0.0) or not np.isfinite(kc):
+                continue
+            delta = 1e-30 * t_max / kc  # any small step: the derivative is in Im
+            for m in range(3):
+                ht[m] = he[m] + 1j * delta * kmat[e, m, k]
+            ok = _partial(ht[0], ht[1], ht[2], w[e], ea[e], l0[e], ls, lf, ptr[e], ptr[e + 1],
+                          d, f6, True)
+            if not ok or not _inv_sym3(f6, kk):
+                continue
+            _mass_one(ht, kk, False, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], gs[e],
+                      gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
+            for r in range(6):
+                for c in range(6):
+                    dout[e, k, r, c] = fade * mt[r, c].imag / delta
 
 
 @njit(cache=True)
