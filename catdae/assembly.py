@@ -224,13 +224,30 @@ class Model:
             u[dof], v[dof], a[dof] = tf.evaluate(t)
         return u[self.fixed], v[self.fixed], a[self.fixed]
 
-    def breakpoints(self, t0: float, t1: float) -> np.ndarray:
-        """Sorted times in (t0, t1) where a support motion or a load has a kink or a jump."""
+    def breakpoints(self, t0: float, t1: float, rel: float = 1e-10) -> list[tuple[float, float]]:
+        """Where a support motion or a load has a kink or a jump, in (t0, t1]: a sorted list of
+        (t_before, t_at). Breakpoints closer than ``rel`` (relative to max(1, |t|)) are one
+        group, at its last time t_at; t_before is just below its first (so that a velocity
+        jump is the sum of all the group's jumps). Groups within ``rel`` of t0 belong to the
+        previous step, which applies them at its end; one within ``rel`` of t1 is at t1."""
         funcs = [tf for _, tf in self.motions]
         funcs += [tf for tf, _ in self.loading.node_timed]
         funcs += [tf for tf, _ in self.loading.internal_timed]
-        times = {float(b) for tf in funcs for b in tf.breakpoints()}
-        return np.array(sorted(b for b in times if t0 < b < t1), float)
+        times = sorted({float(b) for tf in funcs for b in tf.breakpoints()})
+        groups: list[list[float]] = []
+        for b in times:
+            if groups and b - groups[-1][-1] <= rel * max(1.0, abs(b)):
+                groups[-1].append(b)
+            else:
+                groups.append([b])
+        out = []
+        for g in groups:
+            first, last = g[0], g[-1]
+            if last <= t0 + rel * max(1.0, abs(t0)) or first > t1 + rel * max(1.0, abs(t1)):
+                continue
+            at = t1 if last >= t1 - rel * max(1.0, abs(t1)) else last
+            out.append((float(np.nextafter(first, -np.inf)), at))
+        return out
 
     def support_positions(self, t: float) -> np.ndarray:
         """Positions of the fixed dofs at time t: case position + motion, (n_fixed,)."""

@@ -405,7 +405,7 @@ def _looks_like_path(obj: Any) -> bool:
     if not isinstance(obj, str) or "\n" in obj:
         return False
     try:
-        if Path(obj).is_file():
+        if Path(obj).exists():  # a file, or a directory (reported as unreadable)
             return True
     except (OSError, ValueError):
         return False

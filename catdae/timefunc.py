@@ -110,7 +110,9 @@ class Ramp(TimeFunction):
         d = self.duration
         a = self.amplitude
         x = (t - self.start) / d
-        inside = (x >= 0.0) & (x < 1.0)
+        # the corners by time, not by x: exactly at the breakpoints() times, so that the slope
+        # is the one after the corner there and the one before it just below (x may round)
+        inside = (t >= self.start) & (t < self.start + d)
         xc = np.clip(x, 0.0, 1.0)
         if self.smooth:
             f = xc**3 * (10.0 - 15.0 * xc + 6.0 * xc**2)

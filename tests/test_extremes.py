@@ -386,35 +386,46 @@ def test_hanging_chain_modes_against_bessel():
     assert np.all(slopes[:, 0] > 1.6), slopes
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "a free-hanging chain shaken at the top, consistent mass with the Lagrangian terms: the "
-    "consistent mass of a vertical element of large element lambda^2 is not smooth in its "
-    "lateral chord (M_zz grows 30 % for a 1 mm offset of a 2 m element: the sag that appears "
-    "takes chord changes with amplified inertia) and dM/dc is huge; IDA's step collapses "
-    "within 0.01 s. inertia = 'paper' runs (M(q) v' without dM/dc)"))
-def test_hanging_chain_shaken_at_the_top_consistent_lagrangian():
-    motion = SHAKE_TOP
+def _shaken_chain(mass_model):
+    """A chain hanging free, its top shaken sideways for 1 s: the sideways disturbance needs
+    2 sqrt(L/g) = 2.86 s to reach the free end, which must not move sideways yet; the
+    work-energy theorem ΔE = ∫ R·v_A dt must hold."""
+    steps = STATIC + transient(1.0, 0.002, rtol=1e-6, atol=1e-8).replace(
+        'kind = "transient"', f'kind = "transient"\nmass_model = "{mass_model}"')
     text = scene(B=(0.0, 0.0, -20.02), L0=20.0, EA=1e7, mass=1.0, elements=10, supports=("A",),
-                 extra=motion, steps=STATIC + transient(1.0, 0.01, rtol=1e-6, atol=1e-8))
-    ds = catdae.run(text)["dyn"].to_dataset()
-    assert ds.attrs["status"] == "completed"
-
-
-def test_hanging_chain_shaken_at_the_top_paper_inertia():
-    """The same chain with inertia = "paper" runs, the support follows its motion, the free end
-    stays below the top, and tensions stay non-negative."""
-    motion = SHAKE_TOP
-    steps = STATIC + transient(1.0, 0.01, rtol=1e-6, atol=1e-8).replace(
-        'kind = "transient"', 'kind = "transient"\ninertia = "paper"')
-    text = scene(B=(0.0, 0.0, -20.02), L0=20.0, EA=1e7, mass=1.0, elements=10, supports=("A",),
-                 extra=motion, steps=steps)
+                 extra=SHAKE_TOP, steps=steps)
     ds = catdae.run(text)["dyn"].to_dataset()
     assert ds.attrs["status"] == "completed"
     t = ds.time.values
     np.testing.assert_allclose(ds.position.sel(node="A", axis="x").values,
                                0.2 * np.sin(np.pi * t), atol=1e-12)
     assert float(ds.tension.min()) >= 0.0
-    assert float(ds.position.sel(node="B", axis="z").max()) < -19.9
+    # causality: the sideways disturbance has not reached the free end (it rises by about
+    # 1 cm at once, the second-order shortening of the top element's height, 0.2²/(2·2 m),
+    # carried by the stiff axial direction); 2.5 % of the top's 0.2 m allows for the little
+    # that a coupled (linear) mass matrix passes ahead of the wave
+    assert float(np.abs(ds.position.sel(node="B", axis="x")).max()) < 5e-3
+    power = (ds.reaction.sel(node="A").values * ds.velocity.sel(node="A").values).sum(1)
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+    de = ds.energy_total.values - ds.energy_total.values[0]
+    assert np.abs(work).max() > 0.1
+    assert np.abs(de - work).max() < 0.01 * np.abs(work).max()
+
+
+@pytest.mark.parametrize("mass_model", ["lumped", "linear"])
+def test_hanging_chain_shaken_at_the_top(mass_model):
+    _shaken_chain(mass_model)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "free-hanging chain, consistent mass: the mass of its near-vertical, high-lambda^2 elements "
+    "varies on a millimetre scale of lateral offset (M_zz +30 % for 1 mm on a 2 m element) and "
+    "the tip element's grows like 1/T_tip; the run completes but the free end moves sideways at "
+    "once (2.4 m within 1 s, before any wave can reach it) and ΔE - W is 54 J against 6 J of "
+    "work. "
+    "Use lumped or linear mass for transients of free-hanging chains"))
+def test_hanging_chain_shaken_at_the_top_consistent():
+    _shaken_chain("consistent")
 
 
 @pytest.mark.parametrize("ne", [1, 4])
@@ -754,6 +765,12 @@ def test_a_case_path_that_is_no_file(tmp_path, capsys, command, what):
     err = capsys.readouterr().err
     assert err.startswith(f"catdae: invalid case: {path}: cannot read the case file"), err
     assert "TOML" not in err
+
+
+def test_a_directory_given_to_catdae_run_as_a_string(tmp_path):
+    with pytest.raises(catdae.CaseError) as info:
+        catdae.run(str(tmp_path))
+    assert "cannot read the case file" in str(info.value)
 
 
 @pytest.mark.parametrize("command", ["check", "run"])
