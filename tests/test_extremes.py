@@ -36,6 +36,7 @@ from reference import (
     irvine_caughey_frequencies,
     taut_string_frequencies,
 )
+from scenes import cable_scene
 
 import catdae
 import catdae.analysis
@@ -60,29 +61,9 @@ def _vec(v) -> str:
 def scene(*, B, L0, EA, mass, weight=None, elements=4, A=(0.0, 0.0, 0.0), supports=("A", "B"),
           extra="", steps="") -> str:
     """One cable c from node A to node B (both pinned unless ``supports`` says otherwise)."""
-    w = "" if weight is None else f"weight = {_f(weight)}\n"
-    sup = "".join(f'{n} = "pinned"\n' for n in supports)
-    return f"""
-title = "extreme scene"
-[materials.m]
-EA = {_f(EA)}
-mass = {_f(mass)}
-{w}
-[nodes]
-A = {_vec(A)}
-B = {_vec(B)}
-[supports]
-{sup}
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = {_f(L0)}
-elements = {elements}
-gauss_points = 3
-{extra}
-{steps}
-"""
+    return cable_scene(B=B, L0=L0, EA=EA, mass=mass, weight=weight, elements=elements, A=A,
+                       gauss_points=3, supports=supports, title="extreme scene", extra=extra,
+                       steps=steps)
 
 
 STATIC = '[[steps]]\nkind = "static"\nname = "static"\n'

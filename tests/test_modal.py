@@ -37,6 +37,10 @@ try:  # tests/ on sys.path (pytest's default "prepend" import mode)
     from reference import irvine_catenary, irvine_caughey_frequencies
 except ImportError:  # pragma: no cover - tests/ imported as a package
     from tests.reference import irvine_catenary, irvine_caughey_frequencies
+try:  # tests/ on sys.path (pytest's default "prepend" import mode)
+    from scenes import cable_scene, modal_step, static_step
+except ImportError:  # pragma: no cover - tests/ imported as a package
+    from tests.scenes import cable_scene, modal_step, static_step
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE1 = ROOT / "cases" / "example1_free_vibration.toml"
@@ -65,33 +69,9 @@ def design(lambda2: float, sag_ratio: float, span: float = 100.0, m: float = 2.0
 
 
 def level_toml(d: dict, elements: int, modes: int = 12, mass_model: str = "consistent") -> str:
-    return f"""
-gravity = {G}
-[materials.c]
-EA = {d['EA']!r}
-mass = {d['m']!r}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [{d['span']!r}, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "c"
-length = {d['L0']!r}
-elements = {elements}
-gauss_points = 3
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = {modes}
-mass_model = "{mass_model}"
-"""
+    return cable_scene(B=(d["span"], 0.0, 0.0), L0=d["L0"], EA=d["EA"], mass=d["m"],
+                       elements=elements, gauss_points=3, gravity=G, material="c",
+                       steps=static_step() + modal_step(modes, mass_model=mass_model))
 
 
 def families(ds) -> dict[str, np.ndarray]:

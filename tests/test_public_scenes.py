@@ -21,6 +21,7 @@ from reference import (
     irvine_catenary_inclined_3d,
     taut_string_frequencies,
 )
+from scenes import cable_scene, static_step, transient_step
 from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import brentq, fsolve
 
@@ -31,31 +32,10 @@ G = 9.81
 
 def single_span(B, L0, EA, mass, elements, extra="", steps=None, gravity=None, A=(0.0, 0.0, 0.0),
                 supports=('A = "pinned"', 'B = "pinned"')):
-    steps = steps if steps is not None else '[[steps]]\nkind = "static"\nname = "st"\n'
-    grav = "" if gravity is None else f"gravity = {gravity!r}\n"
-    A = [float(a) for a in A]
-    B = [float(b) for b in B]
-    return f"""
-title = "scene"
-{grav}
-[materials.m]
-EA = {EA!r}
-mass = {mass!r}
-[nodes]
-A = [{A[0]!r}, {A[1]!r}, {A[2]!r}]
-B = [{B[0]!r}, {B[1]!r}, {B[2]!r}]
-[supports]
-{supports[0]}
-{supports[1]}
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = {L0!r}
-elements = {elements}
-{extra}
-{steps}
-"""
+    """Cable c from A to B titled "scene"; ``supports`` are whole lines ("" for none)."""
+    return cable_scene(B=B, L0=L0, EA=EA, mass=mass, elements=elements, A=A, title="scene",
+                       gravity=gravity, supports=[s for s in supports if s], extra=extra,
+                       steps=static_step() if steps is None else steps)
 
 
 def mesh_order(ne):
@@ -254,26 +234,8 @@ def test_weightless_taut_cable_frequencies_are_the_taut_string_ones(direction):
 def test_release_of_a_load_conserves_energy_and_consecutive_steps_join():
     extra = ('[[loads]]\nname = "P"\ncable = "c"\ns = 3.1\nforce = [0.0, 300.0, -200.0]\n'
              '[[point_masses]]\nname = "pm"\nnode = "c.3"\nmass = 5.0\n')
-    steps = """
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "transient"
-name = "a"
-remove = ["P"]
-duration = 0.25
-output_interval = 0.01
-rtol = 1e-7
-atol = 1e-9
-[[steps]]
-kind = "transient"
-name = "b"
-duration = 0.15
-output_interval = 0.01
-rtol = 1e-7
-atol = 1e-9
-"""
+    steps = (static_step() + transient_step("a", 0.25, 0.01, rtol=1e-7, atol=1e-9, remove=["P"])
+             + transient_step("b", 0.15, 0.01, rtol=1e-7, atol=1e-9))
     t = catdae.run(single_span((10.0, 2.0, 1.0), 10.3, 1.0e6, 2.0, 6, extra, steps))
     a, b = t["a"].ds, t["b"].ds
     for ds in (a, b):
@@ -386,20 +348,8 @@ def test_support_motion_is_followed_exactly_and_its_work_is_the_energy_gain(mass
 def test_mass_proportional_rayleigh_damping_decays_at_alpha_over_two():
     # C = alpha M damps every mode at exp(-alpha t / 2); equal to material damping c = alpha m
     extra = '[[loads]]\nname = "P"\nnode = "c.4"\nforce = [0.0, 5.0, 0.0]\n'
-    steps = """
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "transient"
-name = "tr"
-remove = ["P"]
-duration = 0.8
-output_interval = 0.002
-rtol = 1e-8
-atol = 1e-11
-DAMPING
-"""
+    steps = static_step() + transient_step("tr", 0.8, 0.002, rtol=1e-8, atol=1e-11, remove=["P"],
+                                           extra="DAMPING")
     ys = {}
     rayleigh = 'damping = { kind = "rayleigh", alpha = 0.8, beta = 0.0 }'
     for key, d in (("none", ""), ("rayleigh", rayleigh),

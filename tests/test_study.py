@@ -16,36 +16,19 @@ from catdae import study
 from catdae.case import load_case
 from catdae.study import StudyError, convergence_order, run_study
 
+try:  # tests/ on sys.path (pytest's default "prepend" import mode)
+    from scenes import cable_scene, modal_step, static_step
+except ImportError:  # pragma: no cover - tests/ imported as a package
+    from tests.scenes import cable_scene, modal_step, static_step
+
 CASES = Path(__file__).resolve().parent.parent / "cases"
 GENTLE = CASES / "example2_support_motion_gentle.toml"
 EXAMPLE1 = CASES / "example1_free_vibration.toml"
 
 # Example 1's taut cable (span 44.335 m, unstrained length 44.304 m), statics then modes.
-TAUT = """
-title = "taut cable, modes"
-[materials.strand]
-EA = 4.696e8
-mass = 20.3
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [44.335, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "main"
-ends = ["A", "B"]
-material = "strand"
-length = 44.304
-elements = 8
-[[steps]]
-kind = "static"
-name = "hanging"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 4
-"""
+TAUT = cable_scene(B=(44.335, 0.0, 0.0), L0=44.304, EA="4.696e8", mass=20.3, elements=8,
+                   title="taut cable, modes", material="strand", cable="main",
+                   steps=static_step("hanging") + modal_step(4))
 
 COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
 

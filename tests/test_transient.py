@@ -20,6 +20,11 @@ import catdae
 from catdae.case import load_case
 from catdae.errors import SolverError
 
+try:  # tests/ on sys.path (pytest's default "prepend" import mode)
+    from scenes import cable_scene, static_step, transient_step
+except ImportError:  # pragma: no cover - tests/ imported as a package
+    from tests.scenes import cable_scene, static_step, transient_step
+
 SPAN = 40.0
 L0 = 40.05
 EA = 2.0e7
@@ -39,28 +44,9 @@ name = "p{k}"
 node = "c.{k}"
 force = [0.0, {loads_y * amp!r}, {loads_z * amp!r}]
 """)
-    return f"""
-title = "taut test cable"
-[materials.m]
-EA = {EA!r}
-mass = {MASS!r}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [{SPAN!r}, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = {L0!r}
-elements = {elements}
-gauss_points = 3
-{''.join(loads)}
-{extra}
-{steps}
-"""
+    return cable_scene(B=(SPAN, 0.0, 0.0), L0=L0, EA=EA, mass=MASS, elements=elements,
+                       gauss_points=3, title="taut test cable", extra="".join(loads) + extra,
+                       steps=steps)
 
 
 def release_steps(duration, dt, *, rtol=1e-8, atol=1e-10, damping="", names=None):
@@ -330,18 +316,8 @@ def test_failure_keeps_partial_results(tmp_path, monkeypatch):
 def test_energy_balance_with_a_time_varying_load():
     """A load with a time function has no potential: the total energy changes by its work,
     E(t) - E(0) = ∫ P(t)·v dt (trapezoid over fine outputs), and is not shifted by -P(t)·x."""
-    text = taut_case(steps="""
-[[steps]]
-kind = "static"
-name = "hanging"
-[[steps]]
-kind = "transient"
-name = "forced"
-duration = 0.5
-output_interval = 0.0005
-rtol = 1e-9
-atol = 1e-11
-""", extra="""
+    text = taut_case(steps=static_step("hanging")
+                     + transient_step("forced", 0.5, 0.0005, rtol=1e-9, atol=1e-11), extra="""
 [[loads]]
 name = "shake"
 node = "c.3"
