@@ -307,30 +307,30 @@ class Model:
         return self.elements.element_masses(state, self.gauss_s, self.gauss_w, self.mesh.m,
                                             (ld.mass_elem, ld.mass_s, ld.mass_value))
 
-    def linear_element_mass(self, per_length: np.ndarray | None = None) -> np.ndarray:
+    def linear_element_mass(self, damping: bool = False) -> np.ndarray:
         """Element matrices of straight-line interpolation N = [(1-ξ) I, ξ I], (n_elem, 6, 6).
 
         m L0 / 6 [[2, 1], [1, 2]] ⊗ I per element, plus m_p N(ξ_p)ᵀ N(ξ_p) for point masses
-        inside elements (not with ``per_length``, e.g. material damping per length). The
-        interior of an element moves with its chord, not with its static catenary shape: the
-        element carries axial waves as a bar does, and the matrix does not depend on q.
+        inside elements; with ``damping`` the same for the material damping per length (point
+        masses carry none). The interior of an element moves with its chord, not with its
+        static catenary shape: the element carries axial waves as a bar does, and the matrix
+        does not depend on q (computed once per model).
         """
-        mesh = self.mesh
-        q = mesh.m if per_length is None else per_length
-        key = None if per_length is None else id(per_length)
         cache = self.__dict__.setdefault("_linear_mass_cache", {})
-        if key in cache:
-            return cache[key]
+        if damping in cache:
+            return cache[damping]
+        mesh = self.mesh
+        q = mesh.c if damping else mesh.m
         base = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
         blocks = (q * mesh.L0)[:, None, None] * base[None]  # (n, 2, 2)
         ld = self.loading
-        if per_length is None and ld.mass_value.size:
+        if not damping and ld.mass_value.size:
             xi = ld.mass_s / mesh.L0[ld.mass_elem]
             nn = np.stack([1.0 - xi, xi], axis=1)  # (p, 2)
             np.add.at(blocks, ld.mass_elem, ld.mass_value[:, None, None]
                       * nn[:, :, None] * nn[:, None, :])
         out = np.kron(blocks, np.eye(3)[None])  # (n, 6, 6): node-major blocks of 3
-        cache[key] = out
+        cache[damping] = out
         return out
 
     def dynamic_state(self, X: np.ndarray, h0: np.ndarray | None, material_damping: bool):
@@ -342,7 +342,7 @@ class Model:
         ld = self.loading
         if self.mass_model == "linear":
             state = self.elements.solve(self.chords(X), h0)
-            ce = self.linear_element_mass(mesh.c) if material_damping else None
+            ce = self.linear_element_mass(damping=True) if material_damping else None
             return state, self.linear_element_mass(), ce
         state, me, ce = self.elements.solve_dynamic(
             self.chords(X), h0, self.gauss_s, self.gauss_w, mesh.m,

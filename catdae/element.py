@@ -495,8 +495,8 @@ def _mass_batch(h, kmat, stat, l0, ea, w, ptr, ls, lf, gs, gw, mq, pmptr, pms, p
 
 
 @njit(cache=True)
-def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me, gs, gw, mq,
-                         pmptr, pms, pmm, dout):
+def _mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmptr, pms, pmm,
+                         dout):
     """∂M_e/∂c_k (n, 3, 6, 6) by complex steps along the chord c = x_j - x_i.
 
     M_e depends on the nodes only through the chord, and on the chord through h (∂h/∂c = K):
@@ -513,7 +513,7 @@ def _mass_gradient_batch(chord, l0, ea, w, ptr, ls, lf, h, fflat, kmat, stat, me
     kk = np.empty((3, 3), np.complex128)
     ht = np.empty(3, np.complex128)
     mt = np.empty((6, 6), np.complex128)
-    for e in range(chord.shape[0]):
+    for e in range(h.shape[0]):
         dout[e, :, :, :] = 0.0
         if stat[e] != CONVERGED:
             continue
@@ -787,7 +787,7 @@ class Elements:
                         use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm, want_c,
                         f6, kmat, its, stat, me, ce)
         state = ElementState(h, _sym_from_upper(f6), kmat, its, stat)
-        self._last_dynamic = (chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter)
+        self._last_dynamic = (gs, gw, mq, pmptr, pms, pmm)
         return state, me, (ce if want_c else None)
 
     def element_masses(self, state: ElementState, gauss_s, gauss_w, per_length,
@@ -806,13 +806,13 @@ class Elements:
                     np.ascontiguousarray(per_length, float), pmptr, pms, pmm, out)
         return out
 
-    def mass_gradient(self, state: ElementState, me: np.ndarray) -> np.ndarray:
-        """∂M_e/∂c_k, (n, 3, 6, 6), about the state (and its M_e) of the last solve_dynamic."""
-        chord, f6, gs, gw, mq, pmptr, pms, pmm, tol, max_iter = self._last_dynamic
+    def mass_gradient(self, state: ElementState) -> np.ndarray:
+        """∂M_e/∂c_k, (n, 3, 6, 6), about the state of the last solve_dynamic (its quadrature
+        and point masses)."""
+        gs, gw, mq, pmptr, pms, pmm = self._last_dynamic
         out = np.empty((self.n, 3, 6, 6))
-        _mass_gradient_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf,
-                             state.h, f6, state.K, state.status, me, gs, gw, mq, pmptr, pms,
-                             pmm, out)
+        _mass_gradient_batch(self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, state.h,
+                             state.K, state.status, gs, gw, mq, pmptr, pms, pmm, out)
         return out
 
     def _point_mass_csr(self, point_masses):

@@ -167,7 +167,7 @@ class TransientProblem:
             out = None
         else:
             self.h = state.h
-            dm = m.elements.mass_gradient(state, out[1]) if self.lagrangian else None
+            dm = m.elements.mass_gradient(state) if self.lagrangian else None
             out = (*out, dm)
         self._cache_t, self._cache_q, self._cache = t, np.array(q, copy=True), out
         return out
