@@ -1,0 +1,294 @@
+"""The frozen model of a scene: what :func:`~catdae.case.load_case` returns and catdae reads.
+
+Frozen dataclasses, tuples and read-only mappings, nothing mutable. Constructing these directly
+skips validation.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any, Literal
+
+from ..errors import CaseError
+from ..timefunc import TimeFunction
+from .messages import _found, _is_number
+
+AXES = ("x", "y", "z")
+
+
+class FrozenMap(Mapping):
+    """A read-only, hashable, picklable mapping that keeps insertion order.
+
+    Used instead of ``types.MappingProxyType`` because a ``Case`` must pickle (it is shipped to
+    dask workers by the studies) and a mapping proxy does not.
+    """
+
+    __slots__ = ("_data",)
+
+    def __init__(self, items: Mapping | Iterable[tuple[Any, Any]] = ()):
+        object.__setattr__(self, "_data", dict(items))
+
+    def __getitem__(self, key):
+        return self._data[key]
+
+    def __iter__(self) -> Iterator:
+        return iter(self._data)
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __hash__(self) -> int:
+        return hash(tuple(self._data.items()))
+
+    def __setattr__(self, name, value):
+        raise AttributeError("FrozenMap is read-only")
+
+    def __reduce__(self):
+        return (FrozenMap, (tuple(self._data.items()),))
+
+    def __repr__(self) -> str:
+        return f"FrozenMap({self._data!r})"
+
+
+@dataclass(frozen=True)
+class Material:
+    """A cable material.
+
+    ``EA`` axial stiffness, N (> 0); ``mass`` kg per metre of unstrained cable (>= 0); ``weight``
+    N per metre of unstrained cable (default ``mass * gravity``); ``damping`` material damping per
+    unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``).
+    """
+
+    name: str
+    EA: float
+    mass: float
+    weight: float
+    damping: float = 0.0
+
+
+@dataclass(frozen=True)
+class Cable:
+    """A cable between two named nodes, meshed into ``elements`` of equal unstrained length.
+
+    ``length`` is the unstrained length L0 in m; ``gauss_points`` per element integrate mass,
+    damping and distributed loads. Mesh nodes are ``<name>.<k>``, k = 1 .. elements - 1.
+    """
+
+    name: str
+    ends: tuple[str, str]
+    material: str
+    length: float
+    elements: int = 1
+    gauss_points: int = 3
+
+
+@dataclass(frozen=True)
+class PointMass:
+    """A concentrated mass in kg, at ``node`` or on ``cable`` at unstrained arc length ``s`` (m)."""
+
+    name: str
+    mass: float
+    node: str | None = None
+    cable: str | None = None
+    s: float | None = None
+
+
+@dataclass(frozen=True)
+class Load:
+    """A concentrated force (N, global x, y, z) at ``node`` or on ``cable`` at ``s``.
+
+    ``time`` multiplies the force; ``None`` means a constant load (factor 1).
+    """
+
+    name: str
+    force: tuple[float, float, float]
+    node: str | None = None
+    cable: str | None = None
+    s: float | None = None
+    time: TimeFunction | None = None
+
+
+@dataclass(frozen=True)
+class DistributedLoad:
+    """A force per metre of unstrained cable (N/m, global axes) on the whole of ``cable``."""
+
+    name: str
+    cable: str
+    load: tuple[float, float, float]
+    time: TimeFunction | None = None
+
+
+@dataclass(frozen=True)
+class SupportMotion:
+    """Prescribed displacement (m) of a supported node along fixed axes; ``None``: no motion."""
+
+    node: str
+    x: TimeFunction | None = None
+    y: TimeFunction | None = None
+    z: TimeFunction | None = None
+
+    def moved(self) -> tuple[tuple[str, TimeFunction], ...]:
+        """The ``(axis, function)`` pairs of the axes that move, in x, y, z order."""
+        return tuple((a, f) for a in AXES if (f := getattr(self, a)) is not None)
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Damping of a transient step: ``material`` or ``rayleigh``.
+
+    Rayleigh damping ``C = alpha M + beta K`` is given either by ``alpha`` and ``beta`` or by a
+    damping ``ratio`` reached at two ``frequencies`` (Hz).
+    """
+
+    kind: Literal["material", "rayleigh"]
+    alpha: float | None = None
+    beta: float | None = None
+    ratio: float | None = None
+    frequencies: tuple[float, float] | None = None
+
+    def coefficients(self) -> tuple[float, float]:
+        """Rayleigh ``(alpha, beta)`` in (1/s, s).
+
+        From a ratio ζ at two frequencies, with ω = 2πf, the standard two-frequency formula
+        (Chopra, *Dynamics of Structures*, §11.4) giving exactly ζ at both:
+        ``alpha = 2 ζ ω1 ω2 / (ω1 + ω2)``, ``beta = 2 ζ / (ω1 + ω2)``.
+        """
+        if self.kind != "rayleigh":
+            raise ValueError("material damping has no Rayleigh coefficients")
+        if self.alpha is not None and self.beta is not None:
+            return self.alpha, self.beta
+        if self.ratio is None or self.frequencies is None:
+            raise ValueError("Rayleigh damping needs alpha and beta, or ratio and frequencies")
+        w1, w2 = (2.0 * math.pi * f for f in self.frequencies)
+        return 2.0 * self.ratio * w1 * w2 / (w1 + w2), 2.0 * self.ratio / (w1 + w2)
+
+
+@dataclass(frozen=True)
+class Step:
+    """One analysis step. Fields that do not apply to ``kind`` keep their defaults.
+
+    ``remove`` names point masses or loads taken away from this step on. Static: ``load_steps``.
+    Modal: ``modes``, ``mass_model``. Transient: ``duration`` and ``output_interval`` (s),
+    ``rtol``, ``atol``, ``damping``, ``max_order`` (IDA's BDF order limit), ``linear_solver``,
+    ``mass_model``, ``inertia`` ("lagrangian": M(q) v' plus the velocity terms of Lagrange's
+    equations for T = ½ vᵀ M(q) v, which conserve energy; "paper": M(q) v' alone, the form of
+    Chang, Park & Lee 2008, which does not).
+    """
+
+    kind: Literal["static", "modal", "transient"]
+    name: str
+    remove: tuple[str, ...] = ()
+    modes: int = 10
+    duration: float | None = None
+    output_interval: float | None = None
+    rtol: float = 1e-6
+    atol: float = 1e-8
+    damping: Damping | None = None
+    max_order: int = 5
+    linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
+    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    load_steps: int = 1
+    inertia: Literal["lagrangian", "paper"] = "lagrangian"
+
+
+@dataclass(frozen=True)
+class Case:
+    """A validated scene and its analysis steps. Build it with :func:`load_case`.
+
+    ``nodes`` maps names to ``(x, y, z)`` in m; ``supports`` maps node names to their fixed axes
+    (a subset of ``AXES`` in x, y, z order); ``gravity`` in m/s² acts along -z. ``path`` is the
+    case file (``None`` for text), ``text`` its TOML text, ``name`` its stem. Constructing a Case
+    directly skips validation; mappings and sequences are frozen either way.
+    """
+
+    title: str = ""
+    source: str = ""
+    gravity: float = 9.81
+    materials: Mapping[str, Material] = field(default_factory=FrozenMap)
+    nodes: Mapping[str, tuple[float, float, float]] = field(default_factory=FrozenMap)
+    supports: Mapping[str, tuple[str, ...]] = field(default_factory=FrozenMap)
+    cables: tuple[Cable, ...] = ()
+    point_masses: tuple[PointMass, ...] = ()
+    loads: tuple[Load, ...] = ()
+    distributed_loads: tuple[DistributedLoad, ...] = ()
+    support_motions: tuple[SupportMotion, ...] = ()
+    steps: tuple[Step, ...] = ()
+    path: str | None = None
+    text: str = field(default="", repr=False)
+    name: str = "case"
+
+    def __post_init__(self):
+        for key in ("materials", "nodes", "supports"):
+            object.__setattr__(self, key, FrozenMap(getattr(self, key)))
+        for key in ("cables", "point_masses", "loads", "distributed_loads", "support_motions",
+                    "steps"):
+            object.__setattr__(self, key, tuple(getattr(self, key)))
+
+    def cable(self, name: str) -> Cable:
+        """The cable called ``name``; ``KeyError`` if there is none."""
+        for c in self.cables:
+            if c.name == name:
+                return c
+        raise KeyError(f"no cable named {name!r}")
+
+    def material_of(self, cable: Cable | str) -> Material:
+        """The material of a cable (given as a :class:`Cable` or by name)."""
+        c = self.cable(cable) if isinstance(cable, str) else cable
+        return self.materials[c.material]
+
+    def with_overrides(self, rtol: float | None = None, atol: float | None = None,
+                       elements: int | None = None, mass_model: str | None = None) -> Case:
+        """A new Case with ``rtol``/``atol`` set on every transient step, ``mass_model``
+        ("consistent" or "lumped") on every transient and modal step, and ``elements`` on
+        every cable (``None`` leaves a setting as it is).
+
+        With a new ``elements``, a load or point mass placed on a mesh node ``<cable>.<k>`` is
+        kept at the same place on the cable (its unstrained arc length in the case's mesh).
+        Raises ``CaseError`` if a value is invalid.
+        """
+        problems: list[tuple[str, str]] = []
+        for key, value in (("rtol", rtol), ("atol", atol)):
+            if value is not None and not (_is_number(value) and 0 < value < math.inf):
+                problems.append((key, f"expected a finite number > 0, found {_found(value)}"))
+        if elements is not None and not (
+            isinstance(elements, numbers.Integral) and not isinstance(elements, bool)
+            and elements >= 1
+        ):
+            problems.append(("elements", f"expected an integer >= 1, found {_found(elements)}"))
+        if mass_model is not None and mass_model not in ("consistent", "lumped", "linear"):
+            problems.append(("mass_model", 'expected "consistent", "lumped" or "linear", '
+                             f"found {_found(mass_model)}"))
+        if problems:
+            raise CaseError(self.path, problems)
+        steps = tuple(
+            replace(s, rtol=float(rtol if rtol is not None else s.rtol),
+                    atol=float(atol if atol is not None else s.atol))
+            if s.kind == "transient" else s
+            for s in self.steps
+        )
+        if mass_model is not None:
+            steps = tuple(replace(s, mass_model=mass_model) if s.kind != "static" else s
+                          for s in steps)
+        cables = self.cables
+        point_masses, loads = self.point_masses, self.loads
+        if elements is not None:
+            cables = tuple(replace(c, elements=int(elements)) for c in cables)
+            # a mass or load placed on a mesh node <cable>.<k> stays where it is on the cable:
+            # at the unstrained arc length k L0 / n of the case's own mesh, which the new mesh
+            # carries exactly (at a node, or inside an element)
+            by_name = {c.name: c for c in self.cables}
+
+            def keep_place(item):
+                if item.node is None or item.node in self.nodes:
+                    return item
+                cable, _, k = item.node.rpartition(".")
+                c = by_name[cable]
+                return replace(item, node=None, cable=cable, s=int(k) * c.length / c.elements)
+
+            point_masses = tuple(keep_place(p) for p in point_masses)
+            loads = tuple(keep_place(p) for p in loads)
+        return replace(self, steps=steps, cables=cables, point_masses=point_masses,
+                       loads=loads)

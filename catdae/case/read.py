@@ -1,0 +1,92 @@
+"""Reading a case: pass 1 (TOML syntax), then the builder (passes 2 and 3)."""
+
+from __future__ import annotations
+
+import os
+import re
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from ..errors import CaseError
+from .build import _Builder
+from .messages import _found
+from .model import Case
+
+
+def load_case(path_or_text: str | os.PathLike, *, name: str | None = None) -> Case:
+    """Read and validate a case.
+
+    ``path_or_text`` is a path (a ``PathLike``, or a one-line string ending in ``.toml`` or naming
+    an existing file) or the TOML text itself. ``name`` defaults to the file's stem, or ``"case"``
+    for text. A ``table`` time function's ``file`` is relative to the case file's folder (to the
+    current directory for text). Raises ``CaseError`` listing every problem found.
+    """
+    path: str | None = None
+    if isinstance(path_or_text, os.PathLike) or _looks_like_path(path_or_text):
+        path = os.fspath(path_or_text)
+        try:
+            raw = Path(path).read_bytes()
+        except OSError as exc:
+            reason = exc.strerror or str(exc)
+            raise CaseError(path, [("", f"cannot read the case file: {reason}")]) from None
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise CaseError(path, [("", f"the case file is not UTF-8 text: {exc}")]) from None
+    elif isinstance(path_or_text, bytes | bytearray):
+        try:
+            text = bytes(path_or_text).decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise CaseError(None, [("", f"the case text is not UTF-8: {exc}")]) from None
+    elif isinstance(path_or_text, str):
+        text = path_or_text
+    else:
+        raise CaseError(None, [("", "expected a path or TOML text, found "
+                                    f"{type(path_or_text).__name__}")])
+    text = text.removeprefix("\ufeff")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError(path, [("", _toml_message(str(exc)))]) from None
+    except RecursionError:
+        msg = "malformed TOML: arrays or tables nested too deeply"
+        raise CaseError(path, [("", msg)]) from None
+    if name is None:
+        name = Path(path).stem if path else "case"
+    base_dir = Path(path).parent if path else Path.cwd()
+    return case_from_dict(data, path=path, text=text, name=name, base_dir=base_dir)
+
+
+def case_from_dict(data: Mapping[str, Any], *, path: str | None = None, text: str = "",
+                   name: str = "case", base_dir: str | os.PathLike | None = None) -> Case:
+    """Validate an already-parsed case (the dict ``tomllib`` returns) and build the Case.
+
+    ``base_dir`` resolves ``table`` files (default: the current directory).
+    """
+    if not isinstance(data, Mapping):
+        raise CaseError(path, [("", f"expected a table of keys, found {_found(data)}")])
+    builder = _Builder(path, Path(base_dir) if base_dir is not None else Path.cwd())
+    return builder.build(dict(data), text=text, name=name)
+
+
+def _looks_like_path(obj: Any) -> bool:
+    if not isinstance(obj, str) or "\n" in obj:
+        return False
+    try:
+        if Path(obj).exists():  # a file, or a directory (reported as unreadable)
+            return True
+    except (OSError, ValueError):
+        return False
+    return obj.strip().endswith(".toml") and "=" not in obj
+
+
+def _toml_message(msg: str) -> str:
+    m = re.search(r"\s*\(at line (\d+), column (\d+)\)\s*$", msg)
+    if m:
+        return f"malformed TOML at line {m[1]}, column {m[2]}: {msg[: m.start()]}"
+    m = re.search(r"\s*\(at end of document\)\s*$", msg)
+    if m:
+        return f"malformed TOML at the end of the document: {msg[: m.start()]}"
+    return f"malformed TOML: {msg}"

@@ -1,0 +1,186 @@
+"""Pass 2: the shape and types of each item on its own (pydantic v2 models).
+
+Strict, ``extra='forbid'``, no inf or nan: every key a case file may hold is declared here, with
+its type, bounds and default. Sections whose content depends on a ``kind`` (steps, damping, time
+functions) are validated later, against the model their kind selects.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
+
+_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+Pos = Annotated[float, Field(gt=0)]
+NonNeg = Annotated[float, Field(ge=0)]
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Name = Annotated[str, Field(min_length=1)]
+TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
+
+
+class _Top(BaseModel):
+    model_config = _STRICT
+    title: str = ""
+    source: str = ""
+    gravity: NonNeg = 9.81
+    materials: dict[str, TomlTable] = {}
+    nodes: dict[str, Any] = {}
+    supports: dict[str, Any] = {}
+    cables: list[TomlTable] = []
+    point_masses: list[TomlTable] = []
+    loads: list[TomlTable] = []
+    distributed_loads: list[TomlTable] = []
+    support_motions: list[TomlTable] = []
+    steps: list[TomlTable] = []
+
+
+class _Material(BaseModel):
+    model_config = _STRICT
+    EA: Pos
+    mass: NonNeg
+    weight: NonNeg | None = None
+    damping: NonNeg = 0.0
+
+
+class _Cable(BaseModel):
+    model_config = _STRICT
+    name: Name
+    ends: Annotated[list[Name], Field(min_length=2, max_length=2)]
+    material: Name
+    length: Pos
+    elements: Annotated[int, Field(ge=1)] = 1
+    gauss_points: Annotated[int, Field(ge=1, le=10)] = 3
+
+
+class _PointMass(BaseModel):
+    model_config = _STRICT
+    name: Name
+    mass: Pos
+    node: Name | None = None
+    cable: Name | None = None
+    s: NonNeg | None = None
+
+
+class _Load(BaseModel):
+    model_config = _STRICT
+    name: Name
+    force: Vec3
+    node: Name | None = None
+    cable: Name | None = None
+    s: NonNeg | None = None
+    time: TomlTable | None = None
+
+
+class _DistributedLoad(BaseModel):
+    model_config = _STRICT
+    name: Name | None = None
+    cable: Name
+    load: Vec3
+    time: TomlTable | None = None
+
+
+class _SupportMotion(BaseModel):
+    model_config = _STRICT
+    node: Name
+    x: TomlTable | None = None
+    y: TomlTable | None = None
+    z: TomlTable | None = None
+
+
+class _StaticStep(BaseModel):
+    model_config = _STRICT
+    kind: Literal["static"]
+    name: Name | None = None
+    remove: list[Name] = []
+    load_steps: Annotated[int, Field(ge=1)] = 1
+
+
+class _ModalStep(BaseModel):
+    model_config = _STRICT
+    kind: Literal["modal"]
+    name: Name | None = None
+    remove: list[Name] = []
+    modes: Annotated[int, Field(ge=1)] = 10
+    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+
+
+class _TransientStep(BaseModel):
+    model_config = _STRICT
+    kind: Literal["transient"]
+    name: Name | None = None
+    remove: list[Name] = []
+    duration: Pos
+    output_interval: Pos
+    rtol: Pos = 1e-6
+    atol: Pos = 1e-8
+    damping: TomlTable | None = None
+    max_order: Annotated[int, Field(ge=1, le=5)] = 5
+    linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
+    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    inertia: Literal["lagrangian", "paper"] = "lagrangian"
+
+
+_STEP_MODELS: dict[str, type[BaseModel]] = {
+    "static": _StaticStep, "modal": _ModalStep, "transient": _TransientStep,
+}
+
+
+class _MaterialDamping(BaseModel):
+    model_config = _STRICT
+    kind: Literal["material"]
+
+
+class _RayleighDamping(BaseModel):
+    model_config = _STRICT
+    kind: Literal["rayleigh"]
+    alpha: NonNeg | None = None
+    beta: NonNeg | None = None
+    ratio: Pos | None = None
+    frequencies: Annotated[list[Pos], Field(min_length=2, max_length=2)] | None = None
+
+
+_DAMPING_MODELS: dict[str, type[BaseModel]] = {
+    "material": _MaterialDamping, "rayleigh": _RayleighDamping,
+}
+
+
+class _ConstantTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["constant"]
+    value: float
+
+
+class _RampTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["ramp"]
+    duration: Pos
+    start: float = 0.0
+    smooth: bool = False
+    amplitude: float = 1.0
+
+
+class _SineTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["sine", "cosine"]
+    amplitude: float
+    frequency: Pos
+    phase: float = 0.0
+    offset: float = 0.0
+
+
+class _TableTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["table"]
+    file: Name | None = None
+    t: list[float] | None = None
+    value: list[float] | None = None
+
+
+_TIME_MODELS: dict[str, type[BaseModel]] = {
+    "constant": _ConstantTF, "ramp": _RampTF, "sine": _SineTF, "cosine": _SineTF,
+    "table": _TableTF,
+}
+
+_VEC3 = TypeAdapter(Vec3, config=ConfigDict(strict=True, allow_inf_nan=False))
