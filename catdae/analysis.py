@@ -14,11 +14,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from . import results
+from . import formfind, results
 from .assembly import Model
 from .case import Case, Step, load_case
 from .element import NOT_CONVERGED
 from .errors import CatdaeError, ConvergenceError
+from .frame import rotate_back, to_gravity_frame
 from .mesh import build_mesh
 from .modal import solve_modal
 from .static import solve_static
@@ -53,17 +54,30 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     ov = {k: v for k, v in overrides.items() if v is not None}
     if ov:
         case = case.with_overrides(**ov)
-    mesh = build_mesh(case)
+    # solved where gravity is -z (catdae.frame); vector results are rotated back
+    local, rotation = to_gravity_frame(case)
+    local = formfind.initial_lengths(local)  # form-found lengths: a start
+    find_forms = bool(formfind.pending(local))
+    mesh = build_mesh(local)
     state = _State(mesh.X0.copy())
     groups: dict[str, xr.Dataset] = {}
     steps = case.steps or (Step(kind="static", name="static"),)
     removed: set[str] = set()
-    writer = _Writer(case, output, groups)
+    temperature: float | dict = 0.0
+    writer = _Writer(case, output, groups, rotation)
     for step in steps:
         removed |= set(step.remove)
-        model = Model(case, mesh, removed, mass_model=step.mass_model)
+        if step.temperature_change is not None:
+            temperature = step.temperature_change
         try:
-            ds = _run_step(step, model, state, writer, progress)
+            if find_forms and step.kind == "static":
+                local, mesh, model, ds = _form_step(step, local, removed, temperature, state)
+                find_forms = False
+            else:
+                model = Model(local, mesh.heated(local, temperature), removed,
+                              mass_model=step.mass_model)
+                ds = _run_step(step, model, state, writer, progress)
+            ds = rotate_back(ds, rotation)
         except KeyboardInterrupt:
             # keep what the finished steps computed; the interrupt itself goes on
             tree = results.make_tree(case, groups,
@@ -73,7 +87,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         except CatdaeError as exc:
             ds_partial = getattr(exc, "partial", None)
             if isinstance(ds_partial, xr.Dataset):
-                groups[step.name] = ds_partial
+                groups[step.name] = rotate_back(ds_partial, rotation)
             status = f"failed in step '{step.name}': {exc}"
             tree = results.make_tree(case, groups, status=status)
             exc.partial = tree
@@ -97,8 +111,28 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
     return run_transient(step, model, state, writer, progress)
 
 
+def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _State):
+    """The first static step of a case with form-found cables: the lengths such that their
+    targets hold in it (catdae.formfind). Returns (case with the lengths, its mesh at the
+    reference temperature, the step's model, its dataset)."""
+
+    def evaluate(trial: Case, warm):
+        mesh = build_mesh(trial)
+        model = Model(trial, mesh.heated(trial, temperature), removed)
+        X, h = (mesh.X0, None) if warm is None else (warm[2].X, warm[2].state.h)
+        sol = solve_static(model, X, h, t=state.t, load_steps=step.load_steps)
+        return (mesh, model, sol), model.cable_summary(sol.X, sol.state)
+
+    found, (mesh, model, sol) = formfind.solve(case, step, evaluate)
+    return found, mesh, model, _static_result(model, state, sol)
+
+
 def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
+    return _static_result(model, state, sol)
+
+
+def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
     return results.static_dataset(
@@ -124,8 +158,9 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
 class _Writer:
     """Writes the tree to ``output``: in increments during long steps, atomically at the end."""
 
-    def __init__(self, case: Case, output, groups: dict[str, xr.Dataset]):
+    def __init__(self, case: Case, output, groups: dict[str, xr.Dataset], rotation=None):
         self.case = case
+        self.rotation = rotation
         self.output = Path(output) if output is not None else None
         self.groups = groups
         self.existed = self.output is not None and self.output.exists()
@@ -140,7 +175,8 @@ class _Writer:
         """A readable snapshot of the run so far, beside the output (never over it)."""
         if self.output is None:
             return
-        tree = results.make_tree(self.case, {**self.groups, name: ds},
+        tree = results.make_tree(self.case, {**self.groups,
+                                             name: rotate_back(ds, self.rotation)},
                                  status=f"running step '{name}'")
         results.write_tree(tree, self.partial_path)
 

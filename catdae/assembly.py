@@ -129,7 +129,9 @@ def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
         p = np.asarray(dl.load, float)
         for e in np.flatnonzero(mesh.cable_of_element == ci):
             for k in range(int(mesh.gauss_points[e])):
-                items.append((int(e), float(sg[e, k]), wg[e, k] * mesh.L0[e] * p, dl.time))
+                # p is per metre of unstrained cable at the reference temperature
+                f = wg[e, k] * mesh.L0[e] / mesh.thermal[e] * p
+                items.append((int(e), float(sg[e, k]), f, dl.time))
     # CSR of internal loads, sorted by element then s
     items.sort(key=lambda it: (it[0], it[1]))
     counts = np.bincount([it[0] for it in items], minlength=ne) if items else np.zeros(ne, int)
@@ -398,7 +400,8 @@ class Model:
         return self.elements.end_tensions(state.h)
 
     def cable_summary(self, X: np.ndarray, state: ElementState) -> dict[str, np.ndarray]:
-        """Per cable: tension at its two ends, horizontal tension at its first end, and sag.
+        """Per cable: tension at its two ends, horizontal tension at its first end, sag, and
+        unstrained length (at the reference temperature).
 
         Sag is the largest vertical distance from the chord to the cable (sampled on the exact
         curve of every element); for a vertical chord, the largest distance from the chord.
@@ -429,19 +432,30 @@ class Model:
                     return np.linalg.norm(pts_rel - np.multiply.outer(pts_rel @ u, u), axis=-1)
             d = dist(p)
             k = int(np.argmax(d))
-            # refine the sampled maximum on the exact curve of its element
-            e = int(els[k // s.shape[1]])
-            j = k % s.shape[1]
-            ds_ = mesh.L0[e] / (s.shape[1] - 1)
-            lo, hi = max(0.0, s[e, j] - ds_), min(mesh.L0[e], s[e, j] + ds_)
-            xi = X[mesh.conn[e, 0]] - a
+            # refine the sampled maximum on the exact curve: within one sample of it, which
+            # at an element end reaches into the neighbouring element
+            n_s = s.shape[1]
+            m, j = divmod(k, n_s)
+            spans = [(m, s[els[m], max(j - 1, 0)], s[els[m], min(j + 1, n_s - 1)])]
+            if j == 0 and m > 0:
+                spans.append((m - 1, s[els[m - 1], n_s - 2], s[els[m - 1], n_s - 1]))
+            if j == n_s - 1 and m < len(els) - 1:
+                spans.append((m + 1, s[els[m + 1], 0], s[els[m + 1], 1]))
+            best_sag = float(d[k])
+            for m_, lo, hi in spans:
+                e = int(els[m_])
+                xi = X[mesh.conn[e, 0]] - a
 
-            def neg(sv, e=e, xi=xi, dist=dist):
-                q = np.zeros((mesh.n_elements, 1))
-                q[e, 0] = sv
-                return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
+                def neg(sv, e=e, xi=xi, dist=dist):
+                    q = np.zeros((mesh.n_elements, 1))
+                    q[e, 0] = sv
+                    return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
 
-            best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
-                                   options={"xatol": 1e-10 * mesh.L0[e]})
-            sag[ci] = max(float(d[k]), -float(best.fun))
-        return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag}
+                best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                                       options={"xatol": 1e-10 * mesh.L0[e]})
+                best_sag = max(best_sag, -float(best.fun))
+            sag[ci] = best_sag
+        unstrained = np.bincount(mesh.cable_of_element, weights=mesh.L0 / mesh.thermal,
+                                 minlength=nc)
+        return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag,
+                "unstrained_length": unstrained}

@@ -78,10 +78,13 @@ def main(argv: list[str] | None = None) -> int:
 
 def _check(args) -> int:
     from .case import load_case
+    from .formfind import initial_lengths
+    from .frame import to_gravity_frame
     from .mesh import build_mesh
 
     case = load_case(Path(args.case))  # the command line always names a file
-    mesh = build_mesh(case)
+    # form-found lengths: the estimates, which also reject targets an isolated cable misses
+    mesh = build_mesh(initial_lengths(to_gravity_frame(case)[0]))
     print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
           f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
     return 0

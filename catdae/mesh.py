@@ -12,7 +12,8 @@ arc length.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,6 +41,8 @@ class Mesh:
     c: np.ndarray  # (n_elem,) N s/m², material damping per unstrained length
     gauss_points: np.ndarray  # (n_elem,) int
     s_start: np.ndarray  # (n_elem,) m, arc length of end i along its cable
+    # (n_elem,) 1 + α ΔT: the element arrays above are those of the heated element (below)
+    thermal: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     @property
     def n_nodes(self) -> int:
@@ -54,11 +57,42 @@ class Mesh:
 
     def __post_init__(self):
         object.__setattr__(self, "_node_index", {n: i for i, n in enumerate(self.node_names)})
+        if self.thermal is None:
+            object.__setattr__(self, "thermal", np.ones(len(self.element_names)))
+
+    def heated(self, case: Case, change: float | Mapping[str, float]) -> Mesh:
+        """The mesh at a temperature change ``change`` (K; one number, or per cable name, 0 for
+        cables not named) from the reference temperature of ``self`` (whose ``thermal`` is 1).
+
+        The thermal strain α ΔT adds to the elastic one: the stretch of the cable is
+        1 + α ΔT + T/EA = (1 + α ΔT)(1 + T/(EA (1 + α ΔT))) per unit of unstrained length s.
+        In the heated arc length s' = (1 + α ΔT) s this is exactly an elastic catenary element
+        with L0' = L0 (1 + α ΔT) and EA' = EA (1 + α ΔT), whose weight, mass and damping per
+        unit of s' are those per unit of s divided by 1 + α ΔT (so that w' s' = w s: the
+        tension t(s) and every total are unchanged), and whose loads sit at s' = (1 + α ΔT) s
+        (:meth:`locate` takes s at the reference temperature).
+        """
+        per_cable = np.array([
+            1.0 + case.material_of(c).thermal_expansion * (
+                change.get(c.name, 0.0) if isinstance(change, Mapping) else change)
+            for c in case.cables])
+        f = per_cable[self.cable_of_element]  # (n_elem,)
+        if np.all(f == 1.0):
+            return self
+        bad = np.flatnonzero(per_cable <= 0.0)
+        if bad.size:
+            c = case.cables[int(bad[0])]
+            raise CaseError(case.path, [(f"cables.{c.name}", (
+                f"the temperature change shrinks the cable to nothing (1 + α ΔT = "
+                f"{per_cable[bad[0]]:.3g} <= 0)"))])
+        return replace(self, L0=self.L0 * f, EA=self.EA * f, w=self.w / f, m=self.m / f,
+                       c=self.c / f, s_start=self.s_start * f, thermal=f)
 
     def locate(self, cable: str, s: float) -> tuple[str, int, float]:
         """Where arc length s of a cable falls: ("node", index, 0) or ("element", e, s_local)."""
         ci = self.cable_names.index(cable)
         elems = np.flatnonzero(self.cable_of_element == ci)
+        s = float(s) * self.thermal[elems[0]]  # to the heated arc length
         starts = self.s_start[elems]
         lengths = self.L0[elems]
         total = starts[-1] + lengths[-1]

@@ -80,6 +80,8 @@ def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.
                                         "horizontal tension at the cable's first end")
         ds["sag"] = _var("cable", cables["sag"], "m",
                          "largest vertical distance from chord to cable")
+        ds["unstrained_length"] = _var("cable", cables["unstrained_length"], "m",
+                                       "unstrained length L0 at the reference temperature")
     return ds
 
 

@@ -153,3 +153,22 @@ def test_three_cables_equilibrium():
     assert 5e3 < tmax < 1e4
     # the payload hangs below where the case put it
     assert float(ds.displacement.sel(node="C", axis="z")) < 0.0
+
+
+# ------------------------------------------------------------------------------------------------
+# The conductor strung to a sag, then heated: Irvine's catenary with the thermal strain
+# ------------------------------------------------------------------------------------------------
+def test_conductor_sag_then_temperature():
+    from test_thermal import level_catenary_midspan
+
+    _, tree = run_case("conductor_sag_temperature.toml")
+    strung, hot = tree["strung"].to_dataset(), tree["hot"].to_dataset()
+    L0 = float(strung.unstrained_length[0])
+    EA, w, alpha = 3.0e7, 1.6 * 9.81, 1.9e-5
+    assert irvine_catenary(300.0, 0.0, L0, EA, w)["sag"] == pytest.approx(7.5, rel=1e-8)
+    # the heated cable keeps its unstrained length and sags by the thermal strain exactly
+    assert float(hot.unstrained_length[0]) == L0
+    z_mid, H = level_catenary_midspan(L0, EA, w, alpha * 40.0, span=300.0)
+    assert float(hot.sag[0]) == pytest.approx(-z_mid, rel=1e-8)
+    assert float(hot.horizontal_tension[0]) == pytest.approx(H, rel=1e-8)
+    assert float(hot.sag[0]) > 7.5 + 0.1  # heating added sag the test can see

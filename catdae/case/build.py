@@ -17,14 +17,16 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from ..errors import CaseError
+from ..frame import gravity_rotation, local_axes
 from ..timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
-from .messages import _fmt_path, _found, _message, _short, _unknown
+from .messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from .model import (
     AXES,
     Cable,
     Case,
     Damping,
     DistributedLoad,
+    Form,
     FrozenMap,
     Load,
     Material,
@@ -37,8 +39,10 @@ from .schema import (
     _STEP_MODELS,
     _TIME_MODELS,
     _VEC3,
+    FORM_TARGETS,
     _Cable,
     _DistributedLoad,
+    _Form,
     _Load,
     _Material,
     _PointMass,
@@ -96,7 +100,7 @@ class _Builder:
                 self.problem(err["loc"], _message(err, fields, {}))
             bad = {err["loc"][0] for err in exc.errors()}
             top = _Top.model_validate({k: v for k, v in data.items() if k not in bad})
-        self.gravity = top.gravity
+        self.gravity, self.gravity_direction = self.gravity_vector(top.gravity)
         self.material_names = set(top.materials)
         self.support_names = set(top.supports)
         if not top.supports and "supports" not in bad:
@@ -105,6 +109,7 @@ class _Builder:
         materials = self.materials(top.materials)
         nodes = self.nodes(top.nodes)
         supports = self.supports(top.supports, nodes)
+        self.gravity_supports(supports)
         cables = self.cables(top.cables, materials, nodes)
         if not top.cables and "cables" not in bad:
             self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "
@@ -119,11 +124,13 @@ class _Builder:
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         steps = self.steps(top.steps)
+        self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         if self.problems:
             raise CaseError(self.path, self.problems)
         return Case(
-            title=top.title, source=top.source, gravity=top.gravity,
+            title=top.title, source=top.source, gravity=self.gravity,
+            gravity_direction=self.gravity_direction,
             materials=FrozenMap(materials), nodes=FrozenMap(nodes),
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
@@ -131,13 +138,48 @@ class _Builder:
             steps=tuple(steps), path=self.path, text=text, name=name,
         )
 
+    def gravity_vector(self, raw: Any) -> tuple[float, tuple[float, float, float]]:
+        """``gravity``: a number (m/s², along -z) or ``[gx, gy, gz]``; returns (|g|, unit)."""
+        down = (0.0, 0.0, -1.0)
+        if _is_number(raw):
+            if raw < 0:
+                self.problem(("gravity",), f"expected a value >= 0 (m/s², along -z) or a vector "
+                             f"[gx, gy, gz], found {_found(raw)}")
+                return 9.81, down
+            return float(raw), down
+        try:
+            g = _VEC3.validate_python(raw)
+        except ValidationError:
+            self.problem(("gravity",), "expected a number >= 0 (m/s², along -z) or a vector "
+                         f"[gx, gy, gz] of 3 finite numbers (m/s²), found {_found(raw)}")
+            return 9.81, down
+        norm = math.sqrt(sum(x * x for x in g))
+        if norm == 0.0:
+            return 0.0, down
+        return norm, tuple(float(x) / norm for x in g)
+
+    def gravity_supports(self, supports: dict) -> None:
+        """The scene is solved with gravity along local -z (catdae.frame): every support must
+        fix coordinate axes of that frame."""
+        if self.gravity_direction == (0.0, 0.0, -1.0):
+            return
+        R = gravity_rotation(self.gravity_direction)
+        for node, axes in supports.items():
+            if local_axes(R, axes) is None:
+                self.problem(("supports", node), (
+                    f"fixes {list(axes)} only, and gravity {list(self.gravity_direction)} "
+                    "(unit vector) is not perpendicular to those axes nor along them: the "
+                    "constraint is not a coordinate constraint of the frame in which gravity is "
+                    "vertical; pin the node, or fix axes that gravity is perpendicular to"))
+
     def materials(self, raw: dict[str, dict]) -> dict[str, Material]:
         out = {}
         for key, item in raw.items():
             m, complete = self.validate(_Material, item, ("materials", key))
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
-                out[key] = Material(key, m.EA, m.mass, weight, m.damping)
+                out[key] = Material(key, m.EA, m.mass, weight, m.damping,
+                                    float(m.thermal_expansion))
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:
@@ -231,24 +273,70 @@ class _Builder:
                     self.problem(where + ("material",),
                                  _unknown(c.material, "material", sorted(self.material_names)))
                 ok = False
+            form = self.form(item, c, where)
+            ok = ok and form is not False
+            length = c.length
             if ok and a in nodes and b in nodes:
                 chord = math.dist(nodes[a], nodes[b])
+                if form and form.kind == "pretension":  # SAP2000 / Tibert: taken straight
+                    length = chord / (1.0 + form.value / materials[c.material].EA)
                 if chord < COINCIDENT_TOL:
                     self.problem(where + ("ends",), f"the ends {a!r} and {b!r} coincide "
                                  f"(distance {chord:.3g} m < {COINCIDENT_TOL:g} m)")
                     ok = False
-                elif chord > (1.0 + MAX_STRAIN) * c.length:
-                    strain = chord / c.length - 1.0
-                    self.problem(where + ("length",), (
+                elif length is not None and chord > (1.0 + MAX_STRAIN) * length:
+                    strain = chord / length - 1.0
+                    self.problem(where + ("form" if form else "length",), (
                         f"the chord {a}-{b} is {chord:.6g} m but the unstrained length is "
-                        f"{c.length:.6g} m: a strain of at least {strain:.0%}, above the "
+                        f"{length:.6g} m: a strain of at least {strain:.0%}, above the "
                         f"{MAX_STRAIN:.0%} this model accepts; check the length and the node "
                         "coordinates"))
                     ok = False
             if ok:
-                out[c.name] = (i, Cable(c.name, (a, b), c.material, float(c.length),
-                                        c.elements, c.gauss_points))
+                out[c.name] = (i, Cable(c.name, (a, b), c.material,
+                                        None if length is None else float(length),
+                                        c.elements, c.gauss_points, form or None))
         return out
+
+    def form(self, item: dict, c: Any, where: tuple) -> Form | None | bool:
+        """The cable's ``form`` (None without one); False after reporting a problem."""
+        has_length, has_form = "length" in item, "form" in item
+        if has_length and has_form:
+            self.problem(where, "give either length or form, not both (form finds the length)")
+            return False
+        if not has_length and not has_form:
+            self.problem(where + ("length",), "missing: this key is required: the unstrained "
+                         "length L0 (m), or instead form = { pretension | horizontal_tension | "
+                         "tension (with at) | sag }")
+            return False
+        if not has_form:
+            return None
+        if c.form is None:  # present but not a table: already reported
+            return False
+        v, complete = self.validate(_Form, c.form, where + ("form",))
+        if not complete:
+            return False
+        given = [k for k in FORM_TARGETS if getattr(v, k) is not None]
+        if len(given) != 1:
+            self.problem(where + ("form",), "expected exactly one of pretension (N), "
+                         "horizontal_tension (N), tension (N, with at = end node) or sag (m), "
+                         f"found {', '.join(given) if given else 'none'}")
+            return False
+        kind = given[0]
+        if kind == "tension":
+            if v.at is None:
+                self.problem(where + ("form", "at"), "missing: the end node where the tension "
+                             f"holds, one of {list(c.ends)}")
+                return False
+            if v.at not in c.ends:
+                self.problem(where + ("form", "at"), f"expected an end of the cable, one of "
+                             f"{list(c.ends)}, found {_found(v.at)}")
+                return False
+        elif v.at is not None:
+            self.problem(where + ("form", "at"), "at applies to form = { tension = ..., at = "
+                         f"... }} only, not to {kind}")
+            return False
+        return Form(kind, float(getattr(v, kind)), v.at)
 
     def node_ref(self, ref: str, where: tuple, cables: dict) -> bool:
         """Check a ``node`` field: a [nodes] entry on some cable, or a mesh node ``<cable>.<k>``."""
@@ -323,6 +411,11 @@ class _Builder:
         if v.cable not in cables:
             return False
         length = cables[v.cable][1].length
+        if length is None:
+            self.problem(where + ("s",), f"cable {v.cable!r} has its length found by "
+                         "form-finding, so an arc length s is not known in advance; place it "
+                         f"on a mesh node ({v.cable}.k) instead")
+            return False
         if v.s > length:
             self.problem(where + ("s",), f"expected 0 <= s <= {length:g} (the length of cable "
                          f"{v.cable!r}), found {v.s:g}")
@@ -471,9 +564,43 @@ class _Builder:
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
                          "mass_model": v.mass_model, "inertia": v.inertia}
-            if complete:
-                out.append(Step(kind=kind, name=nm, remove=tuple(v.remove), **extra))
+            temperature = self.temperature(v.temperature_change, where)
+            if complete and temperature is not False:
+                out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
+                                temperature_change=temperature, **extra))
         return out
+
+    def temperature(self, raw: Any, where: tuple) -> float | FrozenMap | None | bool:
+        """A step's ``temperature_change``: K for every cable, or a table cable name -> K."""
+        where = where + ("temperature_change",)
+        if raw is None:
+            return None
+        if _is_number(raw):
+            return float(raw)
+        if not isinstance(raw, dict):
+            self.problem(where, "expected a temperature change in K (a number, for every "
+                         f"cable) or a table cable name -> K, found {_found(raw)}")
+            return False
+        ok = True
+        for key, value in raw.items():
+            if key not in self.cable_names:
+                self.problem(where + (key,), _unknown(key, "cable", sorted(self.cable_names)))
+                ok = False
+            elif not _is_number(value):
+                self.problem(where + (key,), f"expected a temperature change in K (a finite "
+                             f"number), found {_found(value)}")
+                ok = False
+        return FrozenMap({k: float(v) for k, v in raw.items()}) if ok else False
+
+    def form_first_step(self, cables: dict, steps: list[Step], raw_steps: list) -> None:
+        """Form-finding holds in the first static step, which must then come first."""
+        found = [c.name for _, c in cables.values()
+                 if c.form is not None and c.form.kind != "pretension"]
+        if found and raw_steps and raw_steps[0].get("kind") != "static":
+            self.problem(("steps", 0, "kind"), (
+                f"cable {found[0]!r} has its length found by form-finding, which holds in the "
+                "first step: expected a static step first, found "
+                f"{_found(raw_steps[0].get('kind'))}"))
 
     def damping(self, raw: dict, step_where: tuple) -> Damping | None:
         where = step_where + ("damping",)
@@ -615,7 +742,8 @@ class _Builder:
                    if x.node is not None and "." in x.node}
         loaded |= {d.cable for d in distributed}
         for name, (i, c) in cables.items():
-            if materials[c.material].weight > 0 or name in loaded:
+            if (materials[c.material].weight > 0 or name in loaded or c.length is None
+                    or not all(e in nodes for e in c.ends)):  # bad ends: already reported
                 continue
             chord = math.dist(nodes[c.ends[0]], nodes[c.ends[1]])
             if c.length >= chord:

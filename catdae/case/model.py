@@ -59,7 +59,8 @@ class Material:
 
     ``EA`` axial stiffness, N (> 0); ``mass`` kg per metre of unstrained cable (>= 0); ``weight``
     N per metre of unstrained cable (default ``mass * gravity``); ``damping`` material damping per
-    unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``).
+    unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``);
+    ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT.
     """
 
     name: str
@@ -67,22 +68,41 @@ class Material:
     mass: float
     weight: float
     damping: float = 0.0
+    thermal_expansion: float = 0.0
+
+
+@dataclass(frozen=True)
+class Form:
+    """A form-finding target that replaces a cable's ``length``.
+
+    ``kind`` is ``pretension`` (N: L0 = chord / (1 + T/EA), the member taken straight),
+    ``horizontal_tension`` (N, at the cable's first end), ``tension`` (N, at end node ``at``) or
+    ``sag`` (m, the largest vertical distance below the chord), all but ``pretension`` holding in
+    the case's first static step.
+    """
+
+    kind: Literal["pretension", "horizontal_tension", "tension", "sag"]
+    value: float
+    at: str | None = None
 
 
 @dataclass(frozen=True)
 class Cable:
     """A cable between two named nodes, meshed into ``elements`` of equal unstrained length.
 
-    ``length`` is the unstrained length L0 in m; ``gauss_points`` per element integrate mass,
-    damping and distributed loads. Mesh nodes are ``<name>.<k>``, k = 1 .. elements - 1.
+    ``length`` is the unstrained length L0 in m (at the reference temperature); ``gauss_points``
+    per element integrate mass, damping and distributed loads. Mesh nodes are ``<name>.<k>``,
+    k = 1 .. elements - 1. With a ``form`` other than ``pretension`` the length is found by the
+    first static step and is ``None`` until then (see :mod:`catdae.formfind`).
     """
 
     name: str
     ends: tuple[str, str]
     material: str
-    length: float
+    length: float | None
     elements: int = 1
     gauss_points: int = 3
+    form: Form | None = None
 
 
 @dataclass(frozen=True)
@@ -170,7 +190,10 @@ class Damping:
 class Step:
     """One analysis step. Fields that do not apply to ``kind`` keep their defaults.
 
-    ``remove`` names point masses or loads taken away from this step on. Static: ``load_steps``.
+    ``remove`` names point masses or loads taken away from this step on. ``temperature_change``
+    (K) from the reference temperature, from this step on: a number for every cable, a mapping
+    cable name -> K (cables not named: 0), or ``None`` to keep that of the previous step (0 at
+    the start). Static: ``load_steps``.
     Modal: ``modes``, ``mass_model``. Transient: ``duration`` and ``output_interval`` (s),
     ``rtol``, ``atol``, ``damping``, ``max_order`` (IDA's BDF order limit), ``linear_solver``,
     ``mass_model``, ``inertia`` ("lagrangian": M(q) v' plus the velocity terms of Lagrange's
@@ -192,6 +215,11 @@ class Step:
     mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
+    temperature_change: float | Mapping[str, float] | None = None
+
+    def __post_init__(self):
+        if isinstance(self.temperature_change, Mapping):
+            object.__setattr__(self, "temperature_change", FrozenMap(self.temperature_change))
 
 
 @dataclass(frozen=True)
@@ -199,7 +227,8 @@ class Case:
     """A validated scene and its analysis steps. Build it with :func:`load_case`.
 
     ``nodes`` maps names to ``(x, y, z)`` in m; ``supports`` maps node names to their fixed axes
-    (a subset of ``AXES`` in x, y, z order); ``gravity`` in m/s² acts along -z. ``path`` is the
+    (a subset of ``AXES`` in x, y, z order); ``gravity`` in m/s² acts along the unit vector
+    ``gravity_direction`` (default -z). ``path`` is the
     case file (``None`` for text), ``text`` its TOML text, ``name`` its stem. Constructing a Case
     directly skips validation; mappings and sequences are frozen either way.
     """
@@ -207,6 +236,7 @@ class Case:
     title: str = ""
     source: str = ""
     gravity: float = 9.81
+    gravity_direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
     materials: Mapping[str, Material] = field(default_factory=FrozenMap)
     nodes: Mapping[str, tuple[float, float, float]] = field(default_factory=FrozenMap)
     supports: Mapping[str, tuple[str, ...]] = field(default_factory=FrozenMap)
@@ -286,6 +316,15 @@ class Case:
                     return item
                 cable, _, k = item.node.rpartition(".")
                 c = by_name[cable]
+                if c.length is None:  # form-found: the length is not known yet
+                    k_new = int(k) * int(elements) / c.elements
+                    if k_new != int(k_new):
+                        raise CaseError(self.path, [("elements", (
+                            f"{item.name!r} sits on mesh node {item.node!r} of cable {cable!r}, "
+                            f"whose length is found by form-finding; with {elements} elements "
+                            "it would fall between mesh nodes: use a multiple of "
+                            f"{c.elements} elements"))])
+                    return replace(item, node=f"{cable}.{int(k_new)}")
                 return replace(item, node=None, cable=cable, s=int(k) * c.length / c.elements)
 
             point_masses = tuple(keep_place(p) for p in point_masses)

@@ -24,7 +24,7 @@ class _Top(BaseModel):
     model_config = _STRICT
     title: str = ""
     source: str = ""
-    gravity: NonNeg = 9.81
+    gravity: Any = 9.81  # a number (along -z) or [gx, gy, gz]: checked by the builder
     materials: dict[str, TomlTable] = {}
     nodes: dict[str, Any] = {}
     supports: dict[str, Any] = {}
@@ -42,6 +42,7 @@ class _Material(BaseModel):
     mass: NonNeg
     weight: NonNeg | None = None
     damping: NonNeg = 0.0
+    thermal_expansion: float = 0.0
 
 
 class _Cable(BaseModel):
@@ -49,7 +50,8 @@ class _Cable(BaseModel):
     name: Name
     ends: Annotated[list[Name], Field(min_length=2, max_length=2)]
     material: Name
-    length: Pos
+    length: Pos | None = None  # exactly one of length and form (checked by the builder)
+    form: TomlTable | None = None
     elements: Annotated[int, Field(ge=1)] = 1
     gauss_points: Annotated[int, Field(ge=1, le=10)] = 3
 
@@ -94,6 +96,7 @@ class _StaticStep(BaseModel):
     kind: Literal["static"]
     name: Name | None = None
     remove: list[Name] = []
+    temperature_change: Any = None
     load_steps: Annotated[int, Field(ge=1)] = 1
 
 
@@ -102,6 +105,7 @@ class _ModalStep(BaseModel):
     kind: Literal["modal"]
     name: Name | None = None
     remove: list[Name] = []
+    temperature_change: Any = None
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
 
@@ -111,6 +115,7 @@ class _TransientStep(BaseModel):
     kind: Literal["transient"]
     name: Name | None = None
     remove: list[Name] = []
+    temperature_change: Any = None
     duration: Pos
     output_interval: Pos
     rtol: Pos = 1e-6
@@ -121,6 +126,19 @@ class _TransientStep(BaseModel):
     mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
+
+class _Form(BaseModel):
+    """``form = { ... }`` of a cable: exactly one target (the builder checks which)."""
+
+    model_config = _STRICT
+    pretension: Pos | None = None
+    horizontal_tension: Pos | None = None
+    tension: Pos | None = None
+    at: Name | None = None
+    sag: Pos | None = None
+
+
+FORM_TARGETS = ("pretension", "horizontal_tension", "tension", "sag")
 
 _STEP_MODELS: dict[str, type[BaseModel]] = {
     "static": _StaticStep, "modal": _ModalStep, "transient": _TransientStep,
