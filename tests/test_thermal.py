@@ -6,7 +6,8 @@ unstrained length are unchanged. References, each derived here without catdae's 
   written with the thermal strain, solved by brentq;
 - a plumb line with a point load inside an element: z(s) = -∫ (1 + α ΔT + T(σ)/EA) dσ;
 - a weightless taut bar: T = EA (chord/L0 - 1 - α ΔT);
-- a taut string's frequencies k/(2l) sqrt(T l/(m L0)) in a modal step after heating.
+- a taut string's frequencies k/(2l) sqrt(T l/(m L0)) in a modal step after heating;
+- the published result of OpenSees' two-cable CatenaryCable example with a thermal load.
 """
 
 from __future__ import annotations
@@ -164,3 +165,23 @@ def test_bad_thermal_expansion_names_the_field():
     with pytest.raises(CaseError) as err:
         catdae.load_case(text)
     assert "expected a number" in dict(err.value.problems)["materials.m.thermal_expansion"]
+
+
+def test_opensees_two_cable_example_with_a_thermal_load():
+    # OpenSees CatenaryCable verification example (after Salehi Ahmad Abad et al. 2013): two
+    # 50 m cables from (0, 0, 90) to node 2 at (15, 0, 40) (free in x and z) to (30, 60, 30),
+    # E A = 3e7 N, a uniform load of 1 N per unstrained metre along -z, α = 6.5e-6 /K,
+    # ΔT = 100 K. Published: node 2 moves by (8.58693, 0, 2.82578) m.
+    text = (
+        "[materials.s]\nEA = 3.0e7\nmass = 0.1\nweight = 1.0\nthermal_expansion = 6.5e-6\n"
+        "[nodes]\nN1 = [0.0, 0.0, 90.0]\nN2 = [15.0, 0.0, 40.0]\nN3 = [30.0, 60.0, 30.0]\n"
+        '[supports]\nN1 = "pinned"\nN2 = ["y"]\nN3 = "pinned"\n'
+        '[[cables]]\nname = "a"\nends = ["N1", "N2"]\nmaterial = "s"\nlength = 50.0\n'
+        "elements = 4\n"
+        '[[cables]]\nname = "b"\nends = ["N2", "N3"]\nmaterial = "s"\nlength = 50.0\n'
+        "elements = 4\n"
+        '[[steps]]\nkind = "static"\nname = "hot"\ntemperature_change = 100.0\n'
+    )
+    ds = catdae.run(catdae.load_case(text))["hot"].ds
+    assert ds.displacement.sel(node="N2").values == pytest.approx([8.58693, 0.0, 2.82578],
+                                                                  abs=5e-6)
