@@ -123,7 +123,7 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
         sol = solve_static(model, X, h, t=state.t, load_steps=step.load_steps)
         return (mesh, model, sol), model.cable_summary(sol.X, sol.state)
 
-    found, (mesh, model, sol) = formfind.solve(case, step, evaluate)
+    found, (mesh, model, sol) = formfind.solve(case, evaluate)
     return found, mesh, model, _static_result(model, state, sol)
 
 

@@ -148,15 +148,18 @@ def summary(tree) -> str:
 
 
 def _cable_lines(ds) -> list[str]:
-    """Per cable: end tensions, horizontal tension, sag."""
+    """Per cable: end tensions, horizontal tension, sag (and unstrained length)."""
     if "cable" not in ds.coords:
         return []
     out = []
     for k, cab in enumerate(ds.cable.values):
         t_i, t_j = (float(v) for v in ds.cable_end_tension.values[k])
-        out.append(f"    cable {cab}: end tensions {t_i:.6g} N, {t_j:.6g} N; horizontal tension "
-                   f"{float(ds.horizontal_tension.values[k]):.6g} N; sag "
-                   f"{float(ds.sag.values[k]):.6g} m")
+        line = (f"    cable {cab}: end tensions {t_i:.6g} N, {t_j:.6g} N; horizontal tension "
+                f"{float(ds.horizontal_tension.values[k]):.6g} N; sag "
+                f"{float(ds.sag.values[k]):.6g} m")
+        if "unstrained_length" in ds:
+            line += f"; L0 {float(ds.unstrained_length.values[k]):.9g} m"
+        out.append(line)
     return out
 
 

@@ -39,7 +39,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import brentq
 
-from .case import AXES, Case, Step
+from .case import AXES, Case
 from .case.build import MAX_STRAIN
 from .element import SLACK, Elements
 from .errors import CaseError, ConvergenceError
@@ -113,8 +113,8 @@ def _measure_one(el: Elements, h: np.ndarray, status: np.ndarray, chord: np.ndar
         p = el.position(h, s)  # (n, 257, 3)
         ch = np.hypot(chord[0], chord[1])
         q = ((p[..., :2] @ chord[:2]) / ch**2 * chord[2] - p[..., 2]).max(axis=1)
-        q = np.where(slack, np.nan, q)
-    return np.where(slack & (kind != "sag"), 0.0, q)
+        return np.where(slack, np.nan, q)  # a slack weightless element has no shape
+    return np.where(slack, 0.0, q)
 
 
 def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
@@ -184,10 +184,10 @@ def measure(case: Case, summary: dict) -> np.ndarray:
     return np.array(out, float)
 
 
-def solve(case: Case, step: Step, evaluate) -> tuple[Case, object]:
-    """Lengths of the pending cables such that their targets hold in ``step`` (static).
+def solve(case: Case, evaluate) -> tuple[Case, object]:
+    """Lengths of the pending cables such that their targets hold in the first static step.
 
-    ``evaluate(case_trial, warm)`` solves the static step for a case with trial lengths
+    ``evaluate(case_trial, warm)`` solves that step for a case with trial lengths
     (``warm``: a previous result to start from, or None) and returns ``(result, summary)``;
     ``result`` is handed back with the final case. Raises ``CaseError`` when the targets cannot
     be reached together, ``ConvergenceError`` when a static solve of the start fails.

@@ -185,3 +185,19 @@ def test_opensees_two_cable_example_with_a_thermal_load():
     ds = catdae.run(catdae.load_case(text))["hot"].ds
     assert ds.displacement.sel(node="N2").values == pytest.approx([8.58693, 0.0, 2.82578],
                                                                   abs=5e-6)
+
+
+def test_distributed_load_is_per_unstrained_metre_at_the_reference_temperature():
+    # heating lengthens the cable by 1 + α ΔT = 1.05; the loads it carries do not change:
+    # the supports take w L0 + q L0 along z and p L0 along y
+    L0, w, q, p, alpha, dT = 10.5, 1.2 * 9.81, 3.0, 2.0, 1e-3, 50.0
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=L0, EA=1e5, mass=1.2, elements=5,
+                       extra=('[[distributed_loads]]\ncable = "c"\n'
+                              f"load = [0.0, {p!r}, {-q!r}]\n"),
+                       steps=(f'[[steps]]\nkind = "static"\nname = "st"\n'
+                              f"temperature_change = {dT!r}\n"))
+    text = text.replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+    ds = catdae.run(catdae.load_case(text))["st"].ds
+    R = ds.reaction.sel(node=["A", "B"]).values.sum(axis=0)
+    assert R == pytest.approx([0.0, -p * L0, (w + q) * L0], abs=1e-9 * (w + q) * L0)
+    assert float(ds.unstrained_length[0]) == pytest.approx(L0, rel=1e-14)
