@@ -164,3 +164,34 @@ def test_form_finding_needs_a_static_first_step():
     with pytest.raises(CaseError) as err:
         catdae.load_case(text)
     assert "expected a static step first" in dict(err.value.problems)["steps[0].kind"]
+
+
+def test_sap2000_prestressed_cable_net_7_003():
+    # SAP2000 verification example 7-003 (Tibert 1999, comparison example 3): a net of four
+    # intersection points on a 100 ft grid, held by eight inclined members to supports
+    # f = 30 ft above them and joined by four horizontal members; E A = 0.227 in² x 12000 ksi,
+    # self-weight 1e-4 kip/ft, prestress 5.459 kip (horizontal) and 5.325 kip (inclined) in
+    # the straight-member convention, 8 kip down at each intersection point. Consistent
+    # units: ft, kip. Published, SAP2000: (-0.1328, -0.1328, -1.4745) ft at node 1 (Tibert's
+    # own elastic catenary gives -1.4764 ft in z, a 0.13 % different reading of the prestress)
+    nodes = {"n1": (100, 100, 0), "n2": (200, 100, 0), "n3": (100, 200, 0),
+             "n4": (200, 200, 0), "a1": (0, 100, 30), "a2": (300, 100, 30),
+             "a3": (0, 200, 30), "a4": (300, 200, 30), "b1": (100, 0, 30),
+             "b2": (200, 0, 30), "b3": (100, 300, 30), "b4": (200, 300, 30)}
+    members = [("a1", "n1"), ("n2", "a2"), ("a3", "n3"), ("n4", "a4"), ("b1", "n1"),
+               ("n3", "b3"), ("b2", "n2"), ("n4", "b4")]
+    horizontal = [("n1", "n2"), ("n3", "n4"), ("n1", "n3"), ("n2", "n4")]
+    text = "[materials.s]\nEA = 2724.0\nmass = 1.0\nweight = 1e-4\n[nodes]\n"
+    text += "".join(f"{k} = [{x!r}.0, {y!r}.0, {z!r}.0]\n" for k, (x, y, z) in nodes.items())
+    text += "[supports]\n" + "".join(f'{k} = "pinned"\n' for k in nodes if k[0] in "ab")
+    for k, ((a, b), T) in enumerate([(m, 5.325) for m in members]
+                                    + [(m, 5.459) for m in horizontal]):
+        text += (f'[[cables]]\nname = "m{k}"\nends = ["{a}", "{b}"]\nmaterial = "s"\n'
+                 f"form = {{ pretension = {T!r} }}\nelements = 2\n")
+    text += "".join(f'[[loads]]\nname = "p{k}"\nnode = "n{k}"\nforce = [0.0, 0.0, -8.0]\n'
+                    for k in range(1, 5))
+    text += '[[steps]]\nkind = "static"\nname = "loaded"\n'
+    ds = catdae.run(catdae.load_case(text))["loaded"].ds
+    u = ds.displacement.sel(node=["n1", "n2", "n3", "n4"]).values
+    sign = np.array([[1, 1, 1], [-1, 1, 1], [1, -1, 1], [-1, -1, 1]])  # the net's symmetry
+    assert u * sign == pytest.approx(np.tile([-0.1328, -0.1328, -1.4745], (4, 1)), abs=5e-5)
