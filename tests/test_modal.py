@@ -392,7 +392,7 @@ def test_mass_matrix_identities(name, mass_model):
         mf = M[np.ix_(model.free, model.free)]
         assert np.linalg.eigvalsh(mf).min() > 0.0, label
         if mass_model == "consistent":
-            # the compiled mass (modal and transient paths) against the quadrature of §7
+            # the compiled mass (modal and transient paths) against docs/theory.md §7.1
             # written out here from N(s) (which test_element checks by finite differences)
             _, me, _ = model.elements.solve_dynamic(
                 model.chords(X), state.h, model.gauss_s, model.gauss_w, mesh.m, None,
