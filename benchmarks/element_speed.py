@@ -75,7 +75,7 @@ def best_time(fn, min_total=0.05, repeats=7) -> float:
 
 
 # ----------------------------------------------------------------------------------------------
-# pure-numpy reference: one warm Newton iteration, no loads (formulation.md §2-3, classic form)
+# pure-numpy reference: one warm Newton iteration, no loads (docs/theory.md §2-3, classic form)
 # ----------------------------------------------------------------------------------------------
 def numpy_newton_iteration(h, chord, L0, EA, w):
     hx, hy, v = h[:, 0], h[:, 1], h[:, 2]

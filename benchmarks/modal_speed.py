@@ -214,7 +214,7 @@ def main() -> None:
         "converged mesh follows the dispersion of linearly interpolated consistent string "
         "elements, f_h/f = sqrt(6 (1 - cos θ)/(θ² (2 + cos θ))) ≈ 1 + θ²/24 with θ = kh = "
         "(2j - 1)π/14 for symmetric mode j: +0.2, +1.9, +5.3, +10.2, +16.0 % against 224 "
-        "elements, as measured above and as formulation.md §10 expects (about +0.2, +2, +5, "
+        "elements, as measured above and as docs/theory.md §10 derives (about +0.2, +2, +5, "
         "+10 %). The paper's 14-element column "
         "(from the spectrum of a time history) lies closer to catdae's converged mesh than to "
         "its 14-element modes; nothing here is tuned to it.",

@@ -268,7 +268,7 @@ class Model:
         return self.elements.solve(self.chords(X), h0)
 
     def internal_force(self, state: ElementState) -> np.ndarray:
-        """Σ_e r_e: forces the nodes supply to hold the elements, (n_dof,) N (§4)."""
+        """Σ_e r_e: forces the nodes supply to hold the elements, (n_dof,) N (docs/theory.md §4)."""
         r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
         return np.bincount(self.edofs.ravel(), weights=r.reshape(-1),
                            minlength=self.n_dof)
@@ -298,9 +298,10 @@ class Model:
 
     # ------------------------------------------------------------------------------- mass
     def element_mass(self, state: ElementState) -> np.ndarray:
-        """Consistent element matrices Σ_g m L0 w_g NᵀN + point masses, (n_elem, 6, 6) (§7).
+        """Consistent element matrices Σ_g m L0 w_g NᵀN + point masses, (n_elem, 6, 6).
 
-        The compiled quadrature that the transient step also uses (Elements.solve_dynamic).
+        docs/theory.md §7. The compiled quadrature that the transient step also uses
+        (Elements.solve_dynamic).
         With ``mass_model = "linear"`` the constant matrices of straight-line interpolation.
         """
         if self.mass_model == "linear":

@@ -1,4 +1,4 @@
-"""The exact 3-D elastic catenary element (formulation.md §1-6), batched over elements.
+"""The exact 3-D elastic catenary element (docs/theory.md §1-6), batched over elements.
 
 One element runs from node i to node j; ``s`` in [0, L0] is the unstrained arc length from i.
 The unknown of an element is ``h = (Hx, Hy, Vz)``, the tension vector at s = 0 (the force with
@@ -73,7 +73,7 @@ def _asinhc(z):
 def _segment(hx, hy, v, w, ea, a, b, d, f, want_flex):
     """Add the chord (and flexibility) of the load-free stretch [a, b] to d (3,) and f (6,).
 
-    f holds the upper triangle (xx, xy, xz, yy, yz, zz). formulation.md §2-3 in the stable
+    f holds the upper triangle (xx, xy, xz, yy, yz, zz). docs/theory.md §2-3 in the stable
     forms of the module docstring. Returns False where the tension vanishes (singular).
     """
     ell = b - a

@@ -1,4 +1,4 @@
-"""Natural frequencies and mode shapes about a static state (formulation.md §6-7).
+"""Natural frequencies and mode shapes about a static state (docs/theory.md §6-7).
 
 K_t φ = ω² M φ on the free dofs, with the tangent stiffness and the consistent (or lumped) mass
 of the catenary interpolation functions at the current configuration. Small models use LAPACK's

@@ -1,6 +1,6 @@
 """Static equilibrium: Newton on the free dofs with the assembled sparse tangent stiffness.
 
-R(X) = Σ_e r_e(X) - P = 0 on the free dofs (formulation.md §4). Each Newton step solves
+R(X) = Σ_e r_e(X) - P = 0 on the free dofs (docs/theory.md §4). Each Newton step solves
 K_t dX = -R with the sparse tangent stiffness, and is damped by a line search on the slope of the
 total potential energy along the step (:func:`_line_search`). Loads beyond the self-weight (point
 loads, point masses, distributed loads) are applied in load steps; a load step that fails is

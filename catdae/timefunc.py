@@ -166,12 +166,20 @@ class Cosine(TimeFunction):
 class Table(TimeFunction):
     """Cubic-spline interpolation of the points ``(t[i], value[i])``, ``t`` strictly increasing.
 
-    Inside ``[t[0], t[-1]]`` the interpolant is ``scipy.interpolate.CubicSpline`` with *clamped*
-    ends (zero slope at the first and last point): it passes through every point and is C2 there.
-    Outside the range the function is held at its end value with zero derivatives. Because the
-    slope is already zero at the ends, the value and the velocity stay continuous across them
-    (C1); only the second derivative may jump there. ``file`` records where the points came from
-    (as written in the case file), or is ``None`` for inline points.
+    Inside the record, ``[t[0], t[-1])``, the interpolant is ``scipy.interpolate.CubicSpline``
+    with *not-a-knot* ends: it passes through every point, is C2, and takes the slope and
+    curvature at the first and last points from the record itself (the first two and the last
+    two intervals are one cubic each), so that a smooth motion sampled at a step dt is
+    reproduced to O(dt⁴) in value, O(dt³) in velocity and O(dt²) in acceleration up to the ends.
+    Nothing is imposed at the ends: a spline clamped to zero slope there would invent an
+    acceleration spike wherever the record starts or ends moving. Two points give a straight
+    line, three a parabola.
+
+    Outside the record the function is held at its end values, at rest (zero derivatives). A
+    record that starts or ends moving therefore has a jump in velocity at ``t[0]`` or ``t[-1]``
+    (an impulse at the support, :meth:`breakpoints`); its last point belongs to the hold, as the
+    corners of a linear :class:`Ramp` do. ``file`` records where the points came from (as written
+    in the case file), or is ``None`` for inline points.
     """
 
     t: tuple[float, ...]
@@ -182,20 +190,20 @@ class Table(TimeFunction):
 
     def __post_init__(self):
         spline = CubicSpline(np.asarray(self.t, float), np.asarray(self.value, float),
-                             bc_type="clamped")
+                             bc_type="not-a-knot")
         # A cache derived from the frozen fields, set once here and never changed.
         object.__setattr__(self, "_spline", spline)
 
     def _evaluate(self, t):
         t0, t1 = self.t[0], self.t[-1]
         tc = np.clip(t, t0, t1)
-        inside = (t >= t0) & (t <= t1)
+        inside = (t >= t0) & (t < t1)
         sp = self._spline
         return sp(tc), np.where(inside, sp(tc, 1), 0.0), np.where(inside, sp(tc, 2), 0.0)
 
     def breakpoints(self) -> tuple[float, ...]:
-        # the clamped spline meets the held end values with zero slope, but its second
-        # derivative jumps there
+        # the held values meet the record with its end velocity and acceleration, which need
+        # not be zero: the integrator stops and restarts at both ends
         return (self.t[0], self.t[-1])
 
 

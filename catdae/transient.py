@@ -1,4 +1,4 @@
-"""Nonlinear transient dynamics with SUNDIALS IDA (formulation.md §8).
+"""Nonlinear transient dynamics with SUNDIALS IDA (docs/theory.md §8).
 
 The only module that imports sksundae. Unknowns y = [q, v] of the free dofs, interleaved per dof
 (q_k, v_k side by side) after a reverse Cuthill-McKee ordering of the free dofs, so that the
@@ -14,7 +14,7 @@ of the interpolation functions is assembled. The iteration matrix is analytic:
     J = [[c_j I, -I], [K_t(q), c_j M(q) + C(q)]]
 
 (the derivatives of M(q) v' and C(q) v with respect to q are left out; IDA only needs a good
-iteration matrix, see ../shared/ida-notes.md). A trial state where an element cannot be solved
+iteration matrix, docs/theory.md §8). A trial state where an element cannot be solved
 is answered with NaN in the residual, which IDA treats as recoverable: it retries with a smaller
 step. Output is interpolated by IDA at the output times without shortening its own steps.
 

@@ -4,7 +4,7 @@ Every assertion compares the element with something independent of its own earli
 finite differences of the chord and position maps, equilibrium of forces and moments on the solved
 shape, Irvine's elastic catenary solved by a different method (``tests/reference.py``), closed forms
 (straight bar, vertical bar, folded vertical cable, inextensible catenary, two straight bars) and
-the exact identities of formulation.md §3-6.
+the exact identities of docs/theory.md §3-6.
 
 Randomised 3-D elements (hypothesis) cover L0 in [0.5, 500] m, EA/(w L0) in [1e2, 1e8],
 w in [0.1, 1000] N/m, chords of 0.3 L0 to 1.02 L0 in any direction (elevation within 89.9 degrees
@@ -82,7 +82,7 @@ def one(L0, EA, w, loads=()) -> Elements:
 
 
 def tension_vec(h, w, load_s, load_f, s) -> np.ndarray:
-    """t(s) = h + w s e_z - sum_{s_k < s} f_k (formulation.md §1), written here independently."""
+    """t(s) = h + w s e_z - sum_{s_k < s} f_k (docs/theory.md §1), written here independently."""
     t = np.asarray(h, float) + w * s * EZ
     for sk, fk in zip(load_s, load_f, strict=True):
         if sk < s:

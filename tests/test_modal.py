@@ -392,7 +392,7 @@ def test_mass_matrix_identities(name, mass_model):
         mf = M[np.ix_(model.free, model.free)]
         assert np.linalg.eigvalsh(mf).min() > 0.0, label
         if mass_model == "consistent":
-            # the compiled mass (modal and transient paths) against the quadrature of §7
+            # the compiled mass (modal and transient paths) against docs/theory.md §7.1
             # written out here from N(s) (which test_element checks by finite differences)
             _, me, _ = model.elements.solve_dynamic(
                 model.chords(X), state.h, model.gauss_s, model.gauss_w, mesh.m, None,
@@ -500,7 +500,7 @@ def test_example1_table2(capsys):
     14-element column for symmetric modes 1-4; at 14 elements catdae's consistent mass is above
     the converged mesh by the string dispersion of linear consistent elements, (kh)²/24 to
     leading order with k = (2j - 1)π/l for symmetric mode j: +0.2, +1.9, +5.2, +10.1 %
-    (formulation.md §10 expects about +0.2, +2, +5, +10 %). The paper's 14-element column came
+    (docs/theory.md §10 derives about +0.2, +2, +5, +10 %). The paper's 14-element column came
     from the spectrum of a time history and is closer to the converged mesh than that."""
     f14 = example1_symmetric(14)
     f112 = example1_symmetric(112)

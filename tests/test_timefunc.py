@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.interpolate import CubicSpline
 
 from catdae.timefunc import ONE, ZERO, Constant, Cosine, Ramp, Sine, Table, evaluate_or
 
@@ -85,13 +86,15 @@ def test_table_passes_through_points_and_holds_outside(points):
     v = np.array([val for _, val in points])
     table = Table(tuple(t), tuple(v))
     np.testing.assert_allclose(table(t), v, atol=1e-9)
-    # held at the end values outside, with zero derivatives
-    for outside, value in ((t[0] - 1.0, v[0]), (t[-1] + 1.0, v[-1])):
+    # held at the end values outside, at rest; the last point belongs to the hold
+    for outside, value in ((t[0] - 1.0, v[0]), (t[-1] + 1.0, v[-1]), (t[-1], v[-1])):
         f, df, d2f = table.evaluate(outside)
         assert (f, df, d2f) == (pytest.approx(value), 0.0, 0.0)
-    # clamped ends: the slope is zero at the first and last points, so velocity is continuous
-    assert table.evaluate(t[0])[1] == pytest.approx(0.0, abs=1e-9)
-    assert table.evaluate(t[-1])[1] == pytest.approx(0.0, abs=1e-9)
+    # the record's own end velocity just inside its ends (a jump there, hence breakpoints)
+    sp = CubicSpline(t, v)  # not-a-knot, scipy's default
+    for inside in (t[0], np.nextafter(t[-1], -np.inf)):
+        assert table.evaluate(inside)[1] == pytest.approx(float(sp(inside, 1)), abs=1e-9)
+    assert table.breakpoints() == (t[0], t[-1])
 
 
 @settings(max_examples=50, deadline=None)
@@ -102,15 +105,63 @@ def test_table_derivatives_match_finite_differences(points, x):
     check_derivatives(table, t[0] + x * (t[-1] - t[0]), scale=1e-2)
 
 
-def test_table_is_exact_for_a_cubic_with_zero_end_slopes():
-    # p(t) = 3t² - 2t³ has p'(0) = p'(1) = 0: the clamped spline reproduces it exactly
+def test_table_is_exact_for_any_cubic_and_for_lines_and_parabolas():
+    # not-a-knot ends impose nothing: a cubic with non-zero end slope and curvature is
+    # reproduced exactly (a clamped spline would bend it to zero slope at both ends)
     t = np.linspace(0.0, 1.0, 6)
-    table = Table(tuple(t), tuple(3 * t**2 - 2 * t**3))
-    tt = np.linspace(0.0, 1.0, 101)
+    table = Table(tuple(t), tuple(1.0 + 2.0 * t - t**2 + 0.5 * t**3))
+    tt = np.linspace(0.0, 1.0, 101)[:-1]
     f, df, d2f = table.evaluate(tt)
-    np.testing.assert_allclose(f, 3 * tt**2 - 2 * tt**3, atol=1e-12)
-    np.testing.assert_allclose(df, 6 * tt - 6 * tt**2, atol=1e-11)
-    np.testing.assert_allclose(d2f, 6 - 12 * tt, atol=1e-10)
+    np.testing.assert_allclose(f, 1.0 + 2.0 * tt - tt**2 + 0.5 * tt**3, atol=1e-12)
+    np.testing.assert_allclose(df, 2.0 - 2.0 * tt + 1.5 * tt**2, atol=1e-11)
+    np.testing.assert_allclose(d2f, -2.0 + 3.0 * tt, atol=1e-10)
+    # two points: the straight line; three: the parabola through them
+    f, df, d2f = Table((1.0, 3.0), (4.0, 2.0)).evaluate(np.array([1.0, 2.0, 2.5]))
+    np.testing.assert_allclose(f, [4.0, 3.0, 2.5], atol=1e-12)
+    np.testing.assert_allclose(df, -1.0, atol=1e-12)
+    np.testing.assert_allclose(d2f, 0.0, atol=1e-12)
+    f, df, d2f = Table((0.0, 1.0, 2.0), (0.0, 1.0, 4.0)).evaluate(np.array([0.0, 0.5, 1.5]))
+    np.testing.assert_allclose(f, [0.0, 0.25, 2.25], atol=1e-12)
+    np.testing.assert_allclose(df, [0.0, 1.0, 3.0], atol=1e-12)
+    np.testing.assert_allclose(d2f, 2.0, atol=1e-12)
+
+
+def _sampled_motion(dt):
+    """d(t) = 0.5 sin(2t + 0.3) m on [0, 3] s sampled every dt: it starts and ends moving, and
+    its acceleration peaks at 2.0 m/s²; the exact (d, v, a) on a fine grid of the record."""
+    def exact(t):
+        arg = 2.0 * t + 0.3
+        return 0.5 * np.sin(arg), 1.0 * np.cos(arg), -2.0 * np.sin(arg)
+    ts = np.linspace(0.0, 3.0, round(3.0 / dt) + 1)
+    table = Table(tuple(ts), tuple(exact(ts)[0]))
+    tt = np.linspace(0.0, 3.0, 6001)[:-1]  # the record, [t0, t1): t1 belongs to the hold
+    return table, tt, exact(tt)
+
+
+def test_table_reproduces_a_smooth_motion_up_to_its_ends_at_spline_rates():
+    """Displacement, velocity and acceleration converge at the rates of a cubic spline (4, 3, 2)
+    over the whole record, and within two samples of either end the errors stay within the
+    same bounds: the interpolant adds nothing at the ends."""
+    dts = np.array([0.1, 0.05, 0.025, 0.0125])
+    err = []
+    for dt in dts:
+        table, tt, ref = _sampled_motion(dt)
+        got = table.evaluate(tt)
+        err.append([np.abs(g - r).max() for g, r in zip(got, ref, strict=True)])
+        ends = (tt < 2 * dt) | (tt > 3.0 - 2 * dt)
+        # the fourth derivative of the motion is 8 m/s⁴: bounds C |d⁗| dt^(4-k), C = 1
+        for k, (g, r) in enumerate(zip(got, ref, strict=True)):
+            assert np.abs(g - r)[ends].max() < 8.0 * dt ** (4 - k), (dt, k)
+    rates = [np.polyfit(np.log(dts), np.log(e), 1)[0] for e in np.array(err).T]
+    np.testing.assert_allclose(rates, [4.0, 3.0, 2.0], atol=0.35)
+
+
+def test_table_invents_no_acceleration_beyond_the_records_peak():
+    # the record's own peak is 2.0 m/s²; the spline may exceed it only by its O(dt²) error
+    for dt in (0.1, 0.05, 0.02):
+        table, tt, _ = _sampled_motion(dt)
+        peak = np.abs(table.evaluate(tt)[2]).max()
+        assert peak <= 2.0 * (1.0 + dt**2), (dt, peak)
 
 
 def test_evaluate_is_vectorised_and_scalar_in_gives_floats():
