@@ -169,3 +169,19 @@ def test_run_without_a_case_runs_the_bundled_default(tmp_path, capsys):
     assert hang == pytest.approx(w + 100.0 * 9.81, rel=1e-10)
     assert rest == pytest.approx(w, rel=1e-10)
     assert np.all(np.diff(tree["modes"].to_dataset().frequency.values) >= 0)
+
+
+def test_the_plain_install_brings_what_every_command_needs():
+    # `pip install -e .` (the README's install) installs the core requirements only: those
+    # without an `extra == ...` marker. catdae study needs distributed, catdae plot matplotlib,
+    # catdae export meshio.
+    from importlib.metadata import requires
+
+    from packaging.requirements import Requirement
+
+    core = {Requirement(r).name for r in requires("catdae")
+            if "extra" not in str(Requirement(r).marker or "")}
+    assert {"dask", "matplotlib", "meshio"} <= core
+    dask = next(Requirement(r) for r in requires("catdae") if Requirement(r).name == "dask"
+                and "extra" not in str(Requirement(r).marker or ""))
+    assert "distributed" in dask.extras
