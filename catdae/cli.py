@@ -133,10 +133,13 @@ def summary(tree) -> str:
                          f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
                          f"{a.get('n_residual_evaluations')} residuals, "
                          f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
-            d = ds.displacement
+            # supports (reaction defined on some axis) are prescribed: the free nodes' motion
+            free = ds.reaction.isnull().all(("time", "axis"))
+            d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
+                else ds.displacement
             mag = np.sqrt((d**2).sum("axis"))
             node = str(mag.max("time").idxmax("node").values)
-            lines.append(f"    largest motion at node {node}: "
+            lines.append(f"    largest motion of a free node at {node}: "
                          f"{float(mag.sel(node=node).max()):.4g} m; "
                          f"max tension {float(ds.tension.max()):.6g} N")
             if a.get("note"):
