@@ -36,3 +36,12 @@ def read_results(path):
 
 __all__ = ["CaseError", "CatdaeError", "ConvergenceError", "SolverError", "__version__",
            "load_case", "read_results", "run"]
+
+
+def __getattr__(name):
+    """``catdae.plot`` and ``catdae.export`` on first use (matplotlib and meshio load then)."""
+    if name in ("plot", "export"):
+        import importlib
+
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'catdae' has no attribute {name!r}")

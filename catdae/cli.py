@@ -1,4 +1,4 @@
-"""The command line: ``catdae run``, ``catdae check``. No physics here.
+"""The command line: ``catdae run``, ``check``, ``plot``, ``export``, ``study``. No physics.
 
 Errors become one clear message on stderr and a non-zero exit code:
 1 analysis failed (partial results written), 2 invalid case or usage, 130 interrupted.
@@ -15,6 +15,8 @@ import numpy as np
 
 from . import __version__
 from .errors import CaseError, CatdaeError
+
+WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.plot.WHAT
 
 DEFAULT_CASE = "example1_free_vibration.toml"
 
@@ -39,6 +41,25 @@ def _parser() -> argparse.ArgumentParser:
                    help="mass model of every transient and modal step")
     r.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: on a terminal)")
+    r.add_argument("--vtk", metavar="FOLDER",
+                   help="also write VTK time series for ParaView into FOLDER (as catdae export)")
+    pl = sub.add_parser("plot", help="PNG figures of a results file")
+    pl.add_argument("results", help="results file (netCDF) written by catdae run")
+    pl.add_argument("-o", "--output", required=True, metavar="FOLDER",
+                    help="folder for the PNG files <step>-<what>.png")
+    pl.add_argument("--step", nargs="+", metavar="NAME", help="steps to plot (default: all)")
+    pl.add_argument("--what", nargs="+", choices=WHAT, metavar="WHAT",
+                    help=f"figures: {', '.join(WHAT)} (default: all a step can make)")
+    pl.add_argument("--node", help="node of history and spectrum (default: the free node "
+                    "that moves most)")
+    pl.add_argument("--times", nargs="+", type=float, metavar="T",
+                    help="times of profile and tension, s (nearest outputs; default: 5)")
+    ex = sub.add_parser("export", help="export a results file for other tools")
+    ex.add_argument("results", help="results file (netCDF) written by catdae run")
+    ex.add_argument("--vtk", required=True, metavar="FOLDER",
+                    help="VTK time series for ParaView: <step>.pvd and <step>/*.vtu")
+    ex.add_argument("--step", nargs="+", metavar="NAME",
+                    help="steps to export (default: every static and transient step)")
     c = sub.add_parser("check", help="validate a case file and report every problem")
     c.add_argument("case")
     s = sub.add_parser("study", help="accuracy and cost studies (work-precision)",
@@ -59,6 +80,10 @@ def main(argv: list[str] | None = None) -> int:
             return _check(args)
         if args.command == "run":
             return _run(args)
+        if args.command == "plot":
+            return _plot(args)
+        if args.command == "export":
+            return _export(args)
         if args.command == "study":
             from .study import main as study_main
 
@@ -114,6 +139,48 @@ def _run(args) -> int:
         return 1
     print(summary(tree))
     print(f"results written to {out}")
+    if args.vtk:
+        from .export import write_vtk
+
+        for p in write_vtk(tree, args.vtk):
+            print(f"ParaView time series written to {p}")
+    return 0
+
+
+def _plot(args) -> int:
+    from .plot import write_all
+    from .results import read_tree
+
+    if not Path(args.results).is_file():
+        print(f"catdae: no results file {args.results}", file=sys.stderr)
+        return 2
+    tree = read_tree(args.results)
+    try:
+        files = write_all(tree, args.output, steps=args.step, what=args.what, node=args.node,
+                          times=args.times)
+    except CatdaeError as exc:
+        print(f"catdae: {args.results}: {exc}", file=sys.stderr)
+        return 2
+    for f in files:
+        print(f)
+    return 0
+
+
+def _export(args) -> int:
+    from .export import write_vtk
+    from .results import read_tree
+
+    if not Path(args.results).is_file():
+        print(f"catdae: no results file {args.results}", file=sys.stderr)
+        return 2
+    tree = read_tree(args.results)
+    try:
+        files = write_vtk(tree, args.vtk, steps=args.step)
+    except CatdaeError as exc:
+        print(f"catdae: {args.results}: {exc}", file=sys.stderr)
+        return 2
+    for f in files:
+        print(f"ParaView time series written to {f}")
     return 0
 
 
@@ -136,10 +203,13 @@ def summary(tree) -> str:
                          f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
                          f"{a.get('n_residual_evaluations')} residuals, "
                          f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
-            d = ds.displacement
+            # supports (reaction defined on some axis) are prescribed: the free nodes' motion
+            free = ds.reaction.isnull().all(("time", "axis"))
+            d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
+                else ds.displacement
             mag = np.sqrt((d**2).sum("axis"))
             node = str(mag.max("time").idxmax("node").values)
-            lines.append(f"    largest motion at node {node}: "
+            lines.append(f"    largest motion of a free node at {node}: "
                          f"{float(mag.sel(node=node).max()):.4g} m; "
                          f"max tension {float(ds.tension.max()):.6g} N")
             if a.get("note"):

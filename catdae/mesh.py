@@ -41,6 +41,8 @@ class Mesh:
     c: np.ndarray  # (n_elem,) N s/m², material damping per unstrained length
     gauss_points: np.ndarray  # (n_elem,) int
     s_start: np.ndarray  # (n_elem,) m, arc length of end i along its cable
+    cable_of_node: np.ndarray  # (n_nodes,) int, the first cable through the node; -1: none
+    s_node: np.ndarray  # (n_nodes,) m, arc length along that cable (NaN: on no cable)
     # (n_elem,) 1 + α ΔT: the element arrays above are those of the heated element (below)
     thermal: np.ndarray = field(default=None)  # type: ignore[assignment]
 
@@ -128,10 +130,28 @@ class Mesh:
 
 
 def build_mesh(case: Case) -> Mesh:
-    """Mesh every cable of the case on its exact catenary under self-weight."""
-    node_names: list[str] = list(case.nodes)
-    X: list[np.ndarray] = [np.asarray(case.nodes[n], float) for n in node_names]
-    index = {n: i for i, n in enumerate(node_names)}
+    """Mesh every cable of the case on its exact catenary under self-weight.
+
+    Nodes are numbered cable by cable, in the case's order, each cable's from its first end to
+    its last: a node shared by several cables is numbered (and belongs, in ``cable_of_node`` and
+    ``s_node``) with the first cable that reaches it. Nodes on no cable (supports alone) come
+    last, in the order of ``[nodes]``.
+    """
+    node_names: list[str] = []
+    X: list[np.ndarray] = []
+    index: dict[str, int] = {}
+    node_cable: list[int] = []
+    node_s: list[float] = []
+
+    def add(name: str, x, ci: int, s: float) -> int:
+        if name not in index:
+            index[name] = len(node_names)
+            node_names.append(name)
+            X.append(np.asarray(x, float))
+            node_cable.append(ci)
+            node_s.append(s)
+        return index[name]
+
     conn, cab, names, L0, EA, w, m, c, gp, s0 = [], [], [], [], [], [], [], [], [], []
     for ci, cable in enumerate(case.cables):
         mat = case.materials[cable.material]
@@ -141,14 +161,10 @@ def build_mesh(case: Case) -> Mesh:
         le = cable.length / ne
         s_nodes = le * np.arange(1, ne)
         pts = _catenary_points(case, cable, a, b, mat.EA, mat.weight, s_nodes)
-        ids = [index[cable.ends[0]]]
+        ids = [add(cable.ends[0], a, ci, 0.0)]
         for k in range(1, ne):
-            name = f"{cable.name}.{k}"
-            index[name] = len(node_names)
-            node_names.append(name)
-            X.append(pts[k - 1])
-            ids.append(index[name])
-        ids.append(index[cable.ends[1]])
+            ids.append(add(f"{cable.name}.{k}", pts[k - 1], ci, float(s_nodes[k - 1])))
+        ids.append(add(cable.ends[1], b, ci, float(cable.length)))
         for k in range(ne):
             conn.append((ids[k], ids[k + 1]))
             cab.append(ci)
@@ -160,6 +176,8 @@ def build_mesh(case: Case) -> Mesh:
             c.append(mat.damping)
             gp.append(int(cable.gauss_points))
             s0.append(k * le)
+    for name, x in case.nodes.items():
+        add(name, x, -1, np.nan)
     return Mesh(
         node_names=tuple(node_names),
         X0=np.array(X, float).reshape(-1, 3),
@@ -174,6 +192,8 @@ def build_mesh(case: Case) -> Mesh:
         c=np.array(c, float),
         gauss_points=np.array(gp, np.int64),
         s_start=np.array(s0, float),
+        cable_of_node=np.array(node_cable, np.int64),
+        s_node=np.array(node_s, float),
     )
 
 

@@ -17,23 +17,50 @@ import xarray as xr
 from . import __version__
 from .mesh import AXES, Mesh
 
+CONVENTIONS = "CF-1.10"
+# CF §4.4: a time coordinate has units "<unit> since <epoch>". The case's clock has no date: its
+# seconds are stored since a nominal epoch, so that t = 4 s is 1970-01-01T00:00:04. The values
+# stay seconds (floats): read_tree opens with decode_times=False; plain xarray would decode
+# them to datetimes.
+TIME_UNITS = "seconds since 1970-01-01 00:00:00"
+TIME_ATTRS = {"units": TIME_UNITS, "calendar": "proleptic_gregorian", "standard_name": "time",
+              "long_name": "time on the case's clock (t = 0 at the start of the case)",
+              "axis": "T"}
+
 
 def _var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
     return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name, **attrs})
 
 
+def _label(dims, values, long_name: str) -> xr.Variable:
+    """A string coordinate: labels carry no units."""
+    return xr.Variable(dims, np.array(values, dtype=object), {"long_name": long_name})
+
+
 def _coords(mesh: Mesh, with_elements: bool = True) -> dict:
+    """Labels and arc lengths. Nodes are stored cable by cable, each from its first end to its
+    last (a node shared by cables with the first that reaches it; mesh.build_mesh)."""
+    on_cable = mesh.cable_of_node >= 0
+    node_cable = np.where(on_cable, np.array(mesh.cable_names, dtype=object)[
+        np.maximum(mesh.cable_of_node, 0)], "")
     coords = {
-        "node": xr.Variable("node", np.array(mesh.node_names, dtype=object),
-                            {"units": "1", "long_name": "node name"}),
-        "axis": xr.Variable("axis", np.array(AXES, dtype=object),
-                            {"units": "1", "long_name": "global axis (z up)"}),
+        "node": _label("node", mesh.node_names, "node name"),
+        "axis": _label("axis", AXES, "global axis (z up)"),
+        "node_cable": _label("node", node_cable,
+                             "cable of the node (the first one through it; empty: none)"),
+        "s": _var("node", mesh.s_node, "m", "unstrained arc length along node_cable"),
     }
     if with_elements:
-        coords["element"] = xr.Variable("element", np.array(mesh.element_names, dtype=object),
-                                        {"units": "1", "long_name": "element name"})
-        coords["end"] = xr.Variable("end", np.array(["i", "j"], dtype=object),
-                                    {"units": "1", "long_name": "element end"})
+        names = np.array(mesh.node_names, dtype=object)
+        s_ends = np.stack([mesh.s_start, mesh.s_start + mesh.L0], axis=1)  # (n_elem, 2) m
+        coords["element"] = _label("element", mesh.element_names, "element name")
+        coords["end"] = _label("end", ["i", "j"], "element end")
+        coords["element_cable"] = _label("element", np.array(mesh.cable_names, dtype=object)[
+            mesh.cable_of_element], "cable of the element")
+        coords["element_node"] = _label(("element", "end"), names[mesh.conn],
+                                        "node at the element end")
+        coords["element_s"] = _var(("element", "end"), s_ends, "m",
+                                   "unstrained arc length of the element end along its cable")
     return coords
 
 
@@ -72,8 +99,7 @@ def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.
         attrs=clean_attrs({"kind": "static", **attrs}),
     )
     if cables is not None:
-        ds = ds.assign_coords(cable=xr.Variable("cable", np.array(mesh.cable_names, dtype=object),
-                                                {"units": "1", "long_name": "cable name"}))
+        ds = ds.assign_coords(cable=_label("cable", mesh.cable_names, "cable name"))
         ds["cable_end_tension"] = _var(("cable", "end"), cables["end_tension"], "N",
                                        "tension at the cable's first (i) and last (j) end")
         ds["horizontal_tension"] = _var("cable", cables["horizontal_tension"], "N",
@@ -90,17 +116,17 @@ def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, s
     """Modal step: frequencies (n_modes,) Hz and shapes (n_modes, n_nodes, 3), unit maximum."""
     n = len(frequency)
     coords = _coords(mesh, with_elements=False)
-    coords["mode"] = xr.Variable("mode", np.arange(1, n + 1),
-                                 {"units": "1", "long_name": "mode number"})
+    coords["mode"] = xr.Variable("mode", np.arange(1, n + 1, dtype=np.int32),
+                                 {"long_name": "mode number"})
     ds = xr.Dataset(
         {
             "frequency": _var("mode", frequency, "Hz", "natural frequency"),
             "shape": _var(("mode", "node", "axis"), shape, "1",
                           "mode shape (largest nodal displacement component = 1)"),
-            "plane": _var("mode", np.array(plane, dtype=object), "1",
-                          "in-plane or out-of-plane (single-span cables; else unclassified)"),
-            "symmetry": _var("mode", np.array(symmetry, dtype=object), "1",
-                             "symmetric or antisymmetric about midspan (single-span cables)"),
+            "plane": _label("mode", plane,
+                            "in-plane or out-of-plane (single-span cables; else unclassified)"),
+            "symmetry": _label("mode", symmetry,
+                               "symmetric or antisymmetric about midspan (single-span cables)"),
         },
         coords=coords,
         attrs=clean_attrs({"kind": "modal", **attrs}),
@@ -113,7 +139,8 @@ def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, 
     """Transient step: histories with time first."""
     d = ("time", "node", "axis")
     coords = _coords(mesh)
-    coords["time"] = xr.Variable("time", np.asarray(time), {"units": "s", "long_name": "time"})
+    coords["time"] = xr.Variable("time", np.asarray(time, float), TIME_ATTRS,
+                                 encoding={"_FillValue": None})  # CF: none on coordinates
     X = np.asarray(X).reshape(len(time), -1, 3)
     data = {
         "position": _var(d, X, "m", "node position"),
@@ -133,17 +160,25 @@ def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, 
 
 
 def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") -> xr.DataTree:
-    """Root with provenance and one group per step, in step order."""
+    """Root with provenance and one group per step, in step order.
+
+    Every group also says ``Conventions`` and has a ``title``, so that a group written as a
+    file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them.
+    """
+    created = datetime.now(UTC).isoformat(timespec="seconds")
     root = xr.Dataset(attrs=clean_attrs({
         "title": case.title,
         "source": case.source,
         "case_toml": case.text,
         "case_name": case.name,
         "catdae_version": __version__,
-        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "created": created,
         "status": status,
-        "Conventions": "CF-1.10",
+        "Conventions": CONVENTIONS,
+        "history": f"{created} catdae {__version__}: run of case {case.name!r} ({status})",
     }))
+    groups = {k: v.assign_attrs(Conventions=CONVENTIONS, title=f"{case.title or case.name}: "
+                                f"step {k}") for k, v in groups.items()}
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 
 
@@ -167,6 +202,12 @@ def write_tree(tree: xr.DataTree, path: str | os.PathLike) -> Path:
 
 
 def read_tree(path: str | os.PathLike) -> xr.DataTree:
-    """Open a results file fully into memory (the file is closed afterwards)."""
-    with xr.open_datatree(path, engine="netcdf4") as tree:
-        return tree.load()
+    """Open a results file fully into memory (the file is closed afterwards). ``time`` stays
+    in seconds on the case's clock (not decoded to dates: see TIME_UNITS)."""
+    with xr.open_datatree(path, engine="netcdf4", decode_times=False) as tree:
+        tree = tree.load()
+    for node in tree.subtree:  # written again, coordinate variables get no fill value (CF)
+        for name in node.dims:
+            if name in node.variables and node.variables[name].dtype.kind == "f":
+                node.variables[name].encoding["_FillValue"] = None
+    return tree

@@ -37,7 +37,6 @@ reproduces the paper's equations for comparison; a lumped mass has no such terms
 
 from __future__ import annotations
 
-import sys
 import time as _time
 import warnings
 
@@ -53,6 +52,7 @@ from . import results
 from .assembly import Model
 from .element import NOT_CONVERGED, ElementState, _dynamic_forces
 from .errors import SolverError
+from .progress import reporter
 
 INCREMENT_SECONDS = 20.0  # wall time between incremental writes of a long run
 STALL_STEP = 1e-12  # a step shorter than this (relative to t or the output interval) ...
@@ -464,7 +464,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     n_restarts = 0
     status = "completed"
     k_done = 0
-    bar = _progress_bar(progress, t_end - t0, step.name)
+    bar = reporter(progress, step.name, t0, t_end)
     last_write = _time.perf_counter()
 
     def dataset(n_valid):
@@ -548,8 +548,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
                        and abs(times[k_done] - t_int) <= 1e-13 * max(abs(t_int), 1.0)):
                     record(k_done, times[k_done], y_last, yp_last)
                     k_done += 1
-            if bar is not None:
-                bar.update(t_int - t0 - bar.n)
+            bar.update(t_int)
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(step.name, dataset(k_done))
                 last_write = _time.perf_counter()
@@ -561,8 +560,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
         status = (f"stopped after t = {times[max(k_done - 1, 0)]:.6g} s by an unexpected "
                   f"error: {type(exc).__name__}: {exc}")
     finally:
-        if bar is not None:
-            bar.close()
+        bar.close()
     ds = dataset(k_done)
     if status != "completed":
         raise SolverError(f"transient step '{step.name}': {status}", termination=status,
@@ -606,14 +604,3 @@ def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> f
         pass
     return 2.0 * np.pi
 
-
-def _progress_bar(progress, total, name):
-    if progress is None:
-        progress = sys.stderr.isatty()
-    if not progress:
-        return None
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc=name, unit="s", leave=False,
-                bar_format="{desc}: {percentage:3.0f}%|{bar}| t={n:.3f}/{total:.3f} s "
-                           "[{elapsed}<{remaining}]")

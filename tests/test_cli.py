@@ -169,3 +169,39 @@ def test_run_without_a_case_runs_the_bundled_default(tmp_path, capsys):
     assert hang == pytest.approx(w + 100.0 * 9.81, rel=1e-10)
     assert rest == pytest.approx(w, rel=1e-10)
     assert np.all(np.diff(tree["modes"].to_dataset().frequency.values) >= 0)
+
+
+def test_the_plain_install_brings_what_every_command_needs():
+    # `pip install -e .` (the README's install) installs the core requirements only: those
+    # without an `extra == ...` marker. catdae study needs distributed, catdae plot matplotlib,
+    # catdae export meshio.
+    from importlib.metadata import requires
+
+    from packaging.requirements import Requirement
+
+    core = {Requirement(r).name for r in requires("catdae")
+            if "extra" not in str(Requirement(r).marker or "")}
+    assert {"dask", "matplotlib", "meshio"} <= core
+    dask = next(Requirement(r) for r in requires("catdae") if Requirement(r).name == "dask"
+                and "extra" not in str(Requirement(r).marker or ""))
+    assert "distributed" in dask.extras
+
+
+def test_the_summary_names_the_free_node_that_moves_most(tmp_path, capsys):
+    # example 2's motion of support A on a taut cable: A moves most of all, and the summary
+    # must name the free node that moves most, not the prescribed support
+    text = (CASES / "example2_support_motion_gentle.toml").read_text()
+    text = (text.replace("length = 15.0", "length = 10.02").replace("0.03", "0.3")
+            .replace("duration = 4.0", "duration = 1.0"))
+    case = tmp_path / "taut.toml"
+    case.write_text(text)
+    out = tmp_path / "taut.nc"
+    assert main(["run", str(case), "--elements", "4", "--rtol", "1e-4", "-o", str(out),
+                 "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    ds = catdae.read_results(out)["excitation"].to_dataset()
+    mag = np.sqrt((ds.displacement**2).sum("axis")).max("time")
+    free = [n for n in ds.node.values if n not in ("A", "B")]
+    expected = str(mag.sel(node=free).idxmax("node").values)
+    assert float(mag.sel(node="A")) > float(mag.sel(node=expected))  # A moves most of all
+    assert f"largest motion of a free node at {expected}: " in printed

@@ -359,7 +359,10 @@ def test_hanging_chain_modes_against_bessel():
         text = scene(B=(0.0, 0.0, -1.001 * L), L0=L, EA=1e9, mass=1.0, elements=ne,
                      supports=("A",), steps=STATIC + modal(6))
         f = catdae.run(text)["modes"].to_dataset().frequency.values
-        np.testing.assert_allclose(f[0::2], f[1::2], rtol=1e-9)  # x and y pairs
+        # x and y pairs, to the eigensolver's round-off on these lowest modes: about
+        # eps * λ_max / λ_min ≈ 1e-6 (axial modes of EA = 1e9 against the pendulum modes);
+        # 1e-9 held only while the dof order happened to make x and y bitwise alike
+        np.testing.assert_allclose(f[0::2], f[1::2], rtol=2e-6)
         errors.append(f[0::2] / exact - 1.0)
     errors = np.array(errors)  # (mesh, mode)
     assert np.all(errors > 0)

@@ -8,6 +8,7 @@ it computed, with a status saying why, and never replaces an existing file.
 from __future__ import annotations
 
 from datetime import datetime
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -106,11 +107,15 @@ def test_every_variable_is_labelled(written):
         for name, node in t.children.items():
             ds = node.to_dataset()
             for v in ds.data_vars:
-                assert ds[v].attrs.get("units"), (name, v)
+                if ds[v].dtype.kind not in "OUS":  # labels (plane, symmetry): no units
+                    assert ds[v].attrs.get("units"), (name, v)
                 assert ds[v].attrs.get("long_name"), (name, v)
             for c in ds.coords:
                 assert ds[c].attrs.get("long_name"), (name, c)
-                assert ds[c].attrs.get("units"), (name, c)  # "1" for names and numbers
+                if ds[c].dtype.kind in "OUS":  # labels: no units (not even "1")
+                    assert "units" not in ds[c].attrs, (name, c)
+                elif c != "mode":  # a mode number is a count
+                    assert ds[c].attrs.get("units"), (name, c)
 
 
 def test_root_attributes_carry_the_provenance(written):
@@ -144,7 +149,9 @@ def test_group_kinds_and_dimensions(written):
     assert md.shape.dims == ("mode", "node", "axis")
     tr = back["tapped"].to_dataset()
     assert tr.position.dims == ("time", "node", "axis")
-    assert tr.time.attrs["units"] == "s"
+    # CF time: seconds since a nominal epoch, kept as seconds (floats) by read_results
+    assert tr.time.attrs["units"] == "seconds since 1970-01-01 00:00:00"
+    assert tr.time.attrs["standard_name"] == "time" and tr.time.dtype == np.float64
     np.testing.assert_allclose(tr.time.values, [0.0, 0.01, 0.02, 0.03, 0.04], atol=1e-12)
     assert tr.attrs["status"] == "completed"
 
@@ -190,3 +197,91 @@ def test_a_failed_run_never_overwrites_an_existing_file(tmp_path, monkeypatch):
     back = catdae.read_results(failed)
     assert back.attrs["status"].startswith("failed in step 'second'")
     assert "first" in back.children
+
+
+THREE = Path(__file__).resolve().parent.parent / "cases" / "three_cables_shared_node.toml"
+
+
+@pytest.fixture(scope="module")
+def three():
+    case = catdae.load_case(THREE)
+    return case, catdae.run(case, progress=False)
+
+
+def test_nodes_are_stored_along_each_cable_with_their_arc_length(three):
+    case, tree = three
+    for name in tree.children:
+        ds = tree[name].to_dataset()
+        cab = [str(c) for c in ds.node_cable.values]
+        # one block of nodes per cable, in the case's order; a shared node with its first cable
+        assert [c for k, c in enumerate(cab) if k == 0 or cab[k - 1] != c] == ["c1", "c2", "c3"]
+        for cable in case.cables:
+            ne = cable.elements
+            nodes = ds.node.values[np.array(cab) == cable.name]
+            s = ds.s.sel(node=nodes).values
+            assert np.all(np.diff(s) > 0), (name, cable.name)  # in order along the cable
+            # the mesh node <cable>.k sits at k L0 / n from the first end
+            inner = [f"{cable.name}.{k}" for k in range(1, ne)]
+            np.testing.assert_allclose(ds.s.sel(node=inner).values,
+                                       np.arange(1, ne) * cable.length / ne, rtol=1e-14)
+        # C: first end of c1 (s = 0), also the first end of c2 and the last of c3
+        assert ds.node_cable.sel(node="C") == "c1" and float(ds.s.sel(node="C")) == 0.0
+        assert list(ds.node.values[:2]) == ["C", "c1.1"]
+        assert list(ds.node.values[8:10]) == ["P1", "c2.1"]  # c2 starts at C, stored already
+        # P1 and P2 end c1 and c2 at their full length; P3 starts c3
+        assert float(ds.s.sel(node="P1")) == pytest.approx(21.0, rel=1e-14)
+        assert float(ds.s.sel(node="P2")) == pytest.approx(21.0, rel=1e-14)
+        assert float(ds.s.sel(node="P3")) == 0.0
+
+
+def test_elements_know_their_cable_end_nodes_and_arc_lengths(three):
+    case, tree = three
+    ds = tree["equilibrium"].to_dataset()
+    for cable in case.cables:
+        el = [f"{cable.name}.{k}" for k in range(1, cable.elements + 1)]
+        assert (ds.element_cable.sel(element=el) == cable.name).all()
+        nodes = ds.element_node.sel(element=el).values  # (n, 2)
+        assert nodes[0, 0] == cable.ends[0] and nodes[-1, 1] == cable.ends[1]
+        assert list(nodes[1:, 0]) == list(nodes[:-1, 1])  # a chain from end to end
+        s = ds.element_s.sel(element=el).values
+        assert s[0, 0] == 0.0 and s[-1, 1] == pytest.approx(cable.length, rel=1e-14)
+        np.testing.assert_allclose(s[1:, 0], s[:-1, 1], rtol=1e-14)
+        # the end nodes of each element are its chord apart: at most its stretched length
+        # L0/n (1 + T_max/EA), and close to it for these sagging cables
+        x = ds.position.sel(node=nodes.ravel()).values.reshape(-1, 2, 3)
+        chord = np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
+        t_max = ds.tension.sel(element=el).values.max(axis=1)
+        ea = case.materials[cable.material].EA
+        assert np.all(chord <= cable.length / cable.elements * (1 + t_max / ea))
+        assert np.all(chord > 0.9 * cable.length / cable.elements)
+
+
+def _cf_high_priority_failures(path: Path, test: str) -> tuple[list, float]:
+    """compliance-checker's verdict on one file: the failed high-priority checks and the score."""
+    import json
+
+    from compliance_checker.runner import CheckSuite, ComplianceChecker
+
+    CheckSuite.load_all_available_checkers()
+    report = path.with_suffix(".json")
+    ComplianceChecker.run_checker(str(path), [test], 0, "normal", output_filename=str(report),
+                                  output_format="json")
+    res = json.loads(report.read_text())[test]
+    failed = [(r["name"], r["msgs"]) for r in res["high_priorities"] if r["msgs"]]
+    return failed, res["scored_points"] / res["possible_points"]
+
+
+def test_every_group_passes_the_cf_checker(written, tmp_path):
+    # compliance-checker reads only the root group of a grouped file: each group is checked
+    # as a file of its own, as a user would write it (tree[name].to_dataset().to_netcdf)
+    tree, path = written
+    back = catdae.read_results(path)
+    assert back.attrs["Conventions"].startswith("CF-") and back.attrs["history"]
+    for name in back.children:
+        f = tmp_path / f"{name}.nc"
+        back[name].to_dataset().to_netcdf(f, engine="netcdf4")
+        failed, score = _cf_high_priority_failures(f, "cf:1.8")
+        assert failed == [], (name, failed)
+        assert score > 0.95, (name, score)
+    failed, _ = _cf_high_priority_failures(path, "cf:1.8")  # the root group of the file
+    assert failed == []

@@ -5,8 +5,10 @@ a stored study is not recomputed."""
 from __future__ import annotations
 
 import math
+import socket
 from pathlib import Path
 
+import distributed
 import numpy as np
 import pytest
 import xarray as xr
@@ -54,8 +56,10 @@ def test_error_shrinks_as_the_tolerance_tightens():
     for v in ("wall_time", *COUNTS, "peak_memory", "error", "status"):
         assert ds[v].dims == study.SETTINGS
         assert "long_name" in ds[v].attrs
-    for v in ("wall_time", *COUNTS, "peak_memory", "error", "status"):
+    for v in ("wall_time", *COUNTS, "peak_memory", "error"):
         assert ds[v].attrs["units"]
+    for v in ("status", "mass_model", "linear_solver"):  # labels: no units
+        assert "units" not in ds[v].attrs and ds[v].attrs["long_name"]
 
 
 def test_error_shrinks_as_the_mesh_refines():
@@ -97,22 +101,43 @@ def test_modal_frequencies_converge_at_the_order_theory_predicts(tmp_path, mass_
     assert (tmp_path / "conv.png").stat().st_size > 1000
 
 
-# No warning filter is needed (pytest runs with warnings as errors): with dashboard_address=None
-# no dashboard port is claimed, so distributed's "Port 8787 is already in use" UserWarning
-# cannot occur, and the scheduler and worker bind to loopback only.
-def test_a_dask_cluster_gives_the_local_numbers():
-    distributed = pytest.importorskip("distributed")
+@pytest.fixture
+def port_8787_taken():
+    """Port 8787 (Dask's default dashboard port) held by someone else, as a Jupyter or another
+    Dask dashboard would; pytest's warnings-as-errors turns distributed's "Port 8787 is already
+    in use" warning into a failure, so a cluster that reaches for 8787 fails the test."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        sock.bind(("127.0.0.1", 8787))
+    except OSError:  # already taken by another process: the same situation
+        sock.close()
+        yield None
+        return
+    sock.listen(1)
+    yield sock
+    sock.close()
+
+
+def test_a_dask_cluster_gives_the_local_numbers(port_8787_taken):
     kw = dict(rtol=[1e-3, 1e-5], atol=[1e-10], elements=[4], duration=0.2)
     local = run_study(GENTLE, scheduler="synchronous", **kw)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
-                                  host="127.0.0.1", dashboard_address=None) as cluster:
+    with study.local_cluster(1) as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        assert cluster.scheduler.http_server.port != 8787
         remote = run_study(GENTLE, scheduler=cluster.scheduler_address, **kw)
     assert remote.attrs["scheduler"] == cluster.scheduler_address
     assert (remote.status.values == "completed").all()
     for v in COUNTS:
         np.testing.assert_array_equal(remote[v].values, local[v].values)
     np.testing.assert_allclose(remote.error.values, local.error.values, rtol=1e-9)
+
+
+def test_the_default_cluster_runs_while_port_8787_is_taken(port_8787_taken, tmp_path):
+    # the study's own LocalCluster (scheduler=None), as `catdae study` starts it
+    ds = run_study(GENTLE, rtol=[1e-3], atol=[1e-10], elements=[4], duration=0.1, workers=1,
+                   store=tmp_path / "store")
+    assert ds.attrs["scheduler"].startswith("distributed.LocalCluster")
+    assert (ds.status.values == "completed").all()
 
 
 def test_a_stored_study_is_not_recomputed(tmp_path, monkeypatch):
@@ -146,7 +171,6 @@ def test_a_stored_study_is_not_recomputed(tmp_path, monkeypatch):
 def test_a_run_lost_on_the_cluster_is_recomputed_on_rerun(tmp_path, monkeypatch):
     # A worker thread in this process (processes=False) sees the monkeypatched task: the
     # rtol=1e-4 run fails as a lost worker or a bug would, outside catdae's own errors.
-    distributed = pytest.importorskip("distributed")
     real = study.execute
 
     def flaky(case_run, step_name, memory="rss"):
@@ -157,9 +181,7 @@ def test_a_run_lost_on_the_cluster_is_recomputed_on_rerun(tmp_path, monkeypatch)
     kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4], duration=0.1,
               store=tmp_path / "store")
     monkeypatch.setattr(study, "execute", flaky)
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  protocol="tcp://", host="127.0.0.1",
-                                  dashboard_address=None) as cluster, \
+    with study.local_cluster(1, processes=False) as cluster, \
             distributed.Client(cluster) as client:
         first = run_study(GENTLE, scheduler=client, **kw)
         status = first.status.squeeze()

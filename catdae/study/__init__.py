@@ -82,6 +82,7 @@ from .core import study_step as study_step
 from .plots import convergence_order, plot_convergence, plot_work_precision
 from .report import summary as summary
 from .report import write_study
+from .runner import local_cluster as local_cluster
 from .runner import run_study
 from .worker import execute
 

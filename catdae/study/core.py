@@ -21,13 +21,13 @@ SETTINGS = ("rtol", "atol", "elements", "gauss_points", "mass_model", "linear_so
 MODAL_SETTINGS = ("elements", "gauss_points", "mass_model")
 STORE_FORMAT = 1  # bump when the stored runs change meaning
 
-_COORD_META = {  # setting -> (units, long_name)
+_COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "rtol": ("1", "relative tolerance of IDA"),
     "atol": ("m", "absolute tolerance of IDA on displacements"),
     "elements": ("1", "elements per cable (0: as in the case file)"),
     "gauss_points": ("1", "Gauss points per element (0: as in the case file)"),
-    "mass_model": ("1", "mass model"),
-    "linear_solver": ("1", "linear solver requested"),
+    "mass_model": ("", "mass model"),
+    "linear_solver": ("", "linear solver requested"),
     "max_order": ("1", "largest BDF order of IDA"),
 }
 _CHOICES = {"mass_model": ("consistent", "lumped", "linear"),

@@ -61,8 +61,9 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     coords = {}
     for n in names:
         vals = np.array(grid[n], dtype=object if n in _CHOICES else None)
-        coords[n] = xr.Variable(n, vals, {"units": _COORD_META[n][0],
-                                          "long_name": _COORD_META[n][1]})
+        units, long_name = _COORD_META[n]
+        coords[n] = xr.Variable(n, vals, {"units": units, "long_name": long_name} if units
+                                else {"long_name": long_name})
     methods = sorted({str(r.attrs.get("memory_method", "")) for r in records.values()} - {""})
     memory = "+".join(methods)
     mem_name = "; ".join(_MEMORY_NAMES[m] for m in methods)
@@ -82,7 +83,7 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     }
     variables = {v: xr.Variable(dims, data[v], {"units": u, "long_name": ln})
                  for v, (u, ln) in meta.items()}
-    variables["status"] = xr.Variable(dims, status, {"units": "1", "long_name": "run status "
+    variables["status"] = xr.Variable(dims, status, {"long_name": "run status "
                                                      "('completed' or why it stopped)"})
     out = xr.Dataset(variables, coords=coords)
     if st.kind == "modal":

@@ -196,15 +196,13 @@ def _execute_all(todo: Mapping[str, Case], step_name: str, memory: str, schedule
         for key, c in todo.items():
             yield key, _package().execute(c, step_name, memory)
         return
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, as_completed
 
     with ExitStack() as stack:
         if isinstance(scheduler, Client):
             client = scheduler
         elif scheduler is None:
-            cluster = stack.enter_context(LocalCluster(
-                n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                dashboard_address=None))
+            cluster = stack.enter_context(local_cluster(workers))
             client = stack.enter_context(Client(cluster))
         else:
             client = stack.enter_context(Client(scheduler))
@@ -221,6 +219,23 @@ def _execute_all(todo: Mapping[str, Case], step_name: str, memory: str, schedule
                                        **{k: math.nan for k in _COUNTS}})
             fut.release()
             yield key, ds
+
+
+def local_cluster(workers: int, processes: bool = True):
+    """A ``distributed.LocalCluster`` that claims no fixed port: the scheduler, the workers
+    and the scheduler's HTTP server each take a free port on 127.0.0.1.
+
+    ``dashboard_address=None`` alone does not do it: the scheduler still starts its HTTP server
+    (health and metrics routes) on the default port 8787, and warns, or fails, when that port is
+    taken. Here the dashboard is off (no Bokeh application) and the HTTP server listens on port
+    0, which the operating system turns into a free one.
+    """
+    from distributed import LocalCluster
+
+    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=processes,
+                        protocol="tcp://", host="127.0.0.1", scheduler_port=0,
+                        dashboard_address=None, worker_dashboard_address=None,
+                        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"})
 
 
 def _scheduler_name(scheduler, workers: int) -> str:
