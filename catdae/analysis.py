@@ -18,7 +18,7 @@ from . import results
 from .assembly import Model
 from .case import Case, Step, load_case
 from .element import NOT_CONVERGED
-from .errors import CatdaeError, ConvergenceError, OutputError
+from .errors import CaseError, CatdaeError, ConvergenceError, OutputError
 from .interrupts import deferred
 from .mesh import build_mesh
 from .modal import solve_modal
@@ -55,6 +55,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     if ov:
         case = case.with_overrides(**ov)
     mesh = build_mesh(case)
+    check_steps(case, mesh)
     state = _State(mesh.X0.copy())
     groups: dict[str, xr.Dataset] = {}
     steps = case.steps or (Step(kind="static", name="static"),)
@@ -92,6 +93,33 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         exc.partial, exc.output_path = tree, writer.output
         raise
     return tree
+
+
+def check_steps(case: Case, mesh) -> None:
+    """What the steps need of the scene, judged before any work (``catdae check`` too).
+
+    A transient step needs inertia at every free node: with no mass there (a massless cable,
+    no point mass) M(q) is singular and the accelerations undefined (they came out NaN).
+    Raises CaseError with the step's field path.
+    """
+    problems = []
+    removed: set[str] = set()
+    for i, step in enumerate(case.steps):
+        removed |= set(step.remove)
+        if step.kind != "transient":
+            continue
+        model = Model(case, mesh, removed, mass_model=step.mass_model)
+        massless = model.lumped_mass_diag().reshape(-1, 3)[:, 0] <= 0.0
+        free = ~model.fixed_mask.all(axis=1)
+        names = [mesh.node_names[k] for k in np.flatnonzero(massless & free)]
+        if names:
+            shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5
+                                            else "")
+            problems.append((f"steps[{i}]", f"transient step '{step.name}': free node(s) "
+                             f"{shown} have no mass, so no acceleration is defined: give the "
+                             "cable's material a mass > 0 or put a point mass there"))
+    if problems:
+        raise CaseError(case.path, problems)
 
 
 def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.Dataset:

@@ -96,11 +96,13 @@ def _say_where(exc: BaseException, when: str) -> None:
 
 
 def _check(args) -> int:
+    from .analysis import check_steps
     from .case import load_case
     from .mesh import build_mesh
 
     case = load_case(Path(args.case))  # the command line always names a file
     mesh = build_mesh(case)
+    check_steps(case, mesh)
     print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
           f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
     return 0

@@ -166,11 +166,11 @@ def write_atomic(data: xr.DataTree | xr.Dataset, path: str | os.PathLike) -> Pat
     path = Path(path)
     tmp = incomplete_name(path)
     try:
-        try:
-            data.to_netcdf(tmp, engine="netcdf4")
-        except RuntimeError as exc:  # how the netCDF/HDF5 library reports a failed write
-            raise _write_failure(data, path, exc) from exc
+        data.to_netcdf(tmp, engine="netcdf4")
         os.replace(tmp, path)
+    except RuntimeError as exc:  # how the netCDF/HDF5 library reports a failed write
+        tmp.unlink(missing_ok=True)
+        raise _write_failure(data, path, exc) from exc
     finally:
         if tmp.exists():
             tmp.unlink()
