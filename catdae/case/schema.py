@@ -11,10 +11,14 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
+from .limits import MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
+
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
 Pos = Annotated[float, Field(gt=0)]
 NonNeg = Annotated[float, Field(ge=0)]
+Time = Annotated[float, Field(ge=MIN_TIME)]  # s: shorter is degenerate (0/0 in a ramp)
+Frequency = Annotated[float, Field(gt=0, le=MAX_FREQUENCY)]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Name = Annotated[str, Field(min_length=1)]
 TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
@@ -50,7 +54,7 @@ class _Cable(BaseModel):
     ends: Annotated[list[Name], Field(min_length=2, max_length=2)]
     material: Name
     length: Pos
-    elements: Annotated[int, Field(ge=1)] = 1
+    elements: Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)] = 1
     gauss_points: Annotated[int, Field(ge=1, le=10)] = 3
 
 
@@ -111,8 +115,8 @@ class _TransientStep(BaseModel):
     kind: Literal["transient"]
     name: Name | None = None
     remove: list[Name] = []
-    duration: Pos
-    output_interval: Pos
+    duration: Time
+    output_interval: Time
     rtol: Pos = 1e-6
     atol: Pos = 1e-8
     damping: TomlTable | None = None
@@ -155,7 +159,7 @@ class _ConstantTF(BaseModel):
 class _RampTF(BaseModel):
     model_config = _STRICT
     kind: Literal["ramp"]
-    duration: Pos
+    duration: Time
     start: float = 0.0
     smooth: bool = False
     amplitude: float = 1.0
@@ -165,7 +169,7 @@ class _SineTF(BaseModel):
     model_config = _STRICT
     kind: Literal["sine", "cosine"]
     amplitude: float
-    frequency: Pos
+    frequency: Frequency
     phase: float = 0.0
     offset: float = 0.0
 
