@@ -225,8 +225,13 @@ class _Writer:
 
     def _lost(self, target: Path, exc: OSError, what: str) -> str:
         reason = exc.strerror or str(exc)
-        kept = (f"the last snapshot of the run is kept in {self.partial_path}"
-                if self.partial_path.exists() else "they are lost")
+        if self.partial_path.exists():
+            kept = f"the last snapshot of the run is kept in {self.partial_path}"
+        elif self.snapshot_error is not None:
+            snap = self.snapshot_error.strerror or str(self.snapshot_error)
+            kept = f"they are lost (the snapshots could not be written either: {snap})"
+        else:
+            kept = "they are lost"
         return f"cannot write {what} to {target}: {reason}; {kept}"
 
     def write_final(self, tree: xr.DataTree) -> None:
