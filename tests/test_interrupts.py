@@ -204,6 +204,18 @@ def test_an_output_that_cannot_be_written_is_refused_before_any_work(tmp_path, m
     assert case.read_text() == THREE.read_text()
 
 
+def test_an_unwritable_directory_is_refused_before_any_work(tmp_path, monkeypatch, capsys):
+    """As root every directory is writable, so the refusal of the system is simulated: on a
+    read-only mount os.access says no, to root too."""
+    real = os.access
+    monkeypatch.setattr(catdae.analysis.os, "access",
+                        lambda p, mode: False if Path(p) == tmp_path else real(p, mode))
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (f"catdae: cannot write the results to {out}: no "
+                                       f"permission to create files in {tmp_path}\n")
+
+
 def _fail_writes(monkeypatch, exc, *, unless=""):
     """Every netCDF write raises ``exc``, except to a file whose name contains ``unless``."""
     real = xr.DataTree.to_netcdf
