@@ -4,7 +4,14 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .errors import CaseError, CatdaeError, ConvergenceError, SolverError
+from .errors import (
+    CaseError,
+    CatdaeError,
+    ConvergenceError,
+    Interrupted,
+    OutputError,
+    SolverError,
+)
 
 try:
     __version__ = version("catdae")
@@ -34,8 +41,8 @@ def read_results(path):
     return read_tree(path)
 
 
-__all__ = ["CaseError", "CatdaeError", "ConvergenceError", "SolverError", "__version__",
-           "load_case", "read_results", "run"]
+__all__ = ["CaseError", "CatdaeError", "ConvergenceError", "Interrupted", "OutputError",
+           "SolverError", "__version__", "load_case", "read_results", "run"]
 
 
 def __getattr__(name):

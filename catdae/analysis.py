@@ -18,8 +18,9 @@ from . import formfind, results
 from .assembly import Model
 from .case import Case, Step, load_case
 from .element import NOT_CONVERGED
-from .errors import CatdaeError, ConvergenceError
+from .errors import CaseError, CatdaeError, ConvergenceError, OutputError
 from .frame import rotate_back, to_gravity_frame
+from .interrupts import deferred
 from .mesh import build_mesh
 from .modal import solve_modal
 from .static import solve_static
@@ -59,6 +60,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     local = formfind.initial_lengths(local)  # form-found lengths: a start
     find_forms = bool(formfind.pending(local))
     mesh = build_mesh(local)
+    check_steps(local, mesh)
     state = _State(mesh.X0.copy())
     groups: dict[str, xr.Dataset] = {}
     steps = case.steps or (Step(kind="static", name="static"),)
@@ -78,27 +80,60 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                               mass_model=step.mass_model)
                 ds = _run_step(step, model, state, writer, progress)
             ds = rotate_back(ds, rotation)
-        except KeyboardInterrupt:
-            # keep what the finished steps computed; the interrupt itself goes on
-            tree = results.make_tree(case, groups,
-                                     status=f"interrupted in step '{step.name}'")
-            writer.write_failed(tree)
+        except KeyboardInterrupt as exc:
+            # keep what the finished steps (and a transient, up to the interrupt) computed;
+            # the interrupt itself goes on
+            ds_partial = getattr(exc, "partial", None)
+            status = f"interrupted in step '{step.name}'"
+            if isinstance(ds_partial, xr.Dataset):
+                groups[step.name] = rotate_back(ds_partial, rotation)
+                status += f": {ds_partial.attrs.get('status')}"
+            writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
         except CatdaeError as exc:
             ds_partial = getattr(exc, "partial", None)
             if isinstance(ds_partial, xr.Dataset):
                 groups[step.name] = rotate_back(ds_partial, rotation)
             status = f"failed in step '{step.name}': {exc}"
-            tree = results.make_tree(case, groups, status=status)
-            exc.partial = tree
-            exc.output_path = writer.write_failed(tree)
+            writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
         groups[step.name] = ds
         if on_group is not None:
             on_group(step.name, ds)
     tree = results.make_tree(case, groups)
-    writer.write_final(tree)
+    try:
+        writer.write_final(tree)
+    except KeyboardInterrupt as exc:  # a signal held back while the complete file was written
+        exc.partial, exc.output_path = tree, writer.output
+        raise
     return tree
+
+
+def check_steps(case: Case, mesh) -> None:
+    """What the steps need of the scene, judged before any work (``catdae check`` too).
+
+    A transient step needs inertia at every free node: with no mass there (a massless cable,
+    no point mass) M(q) is singular and the accelerations undefined (they came out NaN).
+    Raises CaseError with the step's field path.
+    """
+    problems = []
+    removed: set[str] = set()
+    for i, step in enumerate(case.steps):
+        removed |= set(step.remove)
+        if step.kind != "transient":
+            continue
+        model = Model(case, mesh, removed, mass_model=step.mass_model)
+        massless = model.lumped_mass_diag().reshape(-1, 3)[:, 0] <= 0.0
+        free = ~model.fixed_mask.all(axis=1)
+        names = [mesh.node_names[k] for k in np.flatnonzero(massless & free)]
+        if names:
+            shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5
+                                            else "")
+            problems.append((f"steps[{i}]", f"transient step '{step.name}': free node(s) "
+                             f"{shown} have no mass, so no acceleration is defined: give the "
+                             "cable's material a mass > 0 or put a point mass there"))
+    if problems:
+        raise CaseError(case.path, problems)
 
 
 def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.Dataset:
@@ -155,15 +190,50 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                   "status": "completed"})
 
 
+def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:
+    """The output path, judged before any work: a regular file (or none yet) in a directory
+    catdae may write in, and not the case file itself. Raises OutputError saying why not."""
+    out = Path(output)
+
+    def refuse(why: str):
+        raise OutputError(f"cannot write the results to {out}: {why}")
+
+    if str(output) == "" or out.is_dir():
+        refuse("it is a directory (give a file name, e.g. -o results.nc)")
+    if out.exists() and not out.is_file():
+        refuse("it exists and is not a regular file")
+    parent = out.parent
+    if not parent.is_dir():
+        refuse(f"no directory {parent}")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        refuse(f"no permission to create files in {parent}")
+    if out.exists() and not os.access(out, os.W_OK):
+        refuse("it exists and is read-only")
+    src = getattr(case, "path", None)
+    if src is not None and out.exists() and Path(src).exists() and out.samefile(src):
+        refuse("it is the case file")
+    return out
+
+
 class _Writer:
-    """Writes the tree to ``output``: in increments during long steps, atomically at the end."""
+    """The one writer of a run's results (atomically, through results.write_tree).
+
+    - ``write_increment``: during long transient steps, a snapshot ``<stem>.partial.nc`` whose
+      unfinished step is marked ``running``; a disk error there is remembered, not fatal.
+    - ``write_final``: the complete tree to the output; the snapshot is then removed.
+    - ``keep_failed``: the tree of a failed or interrupted run, to the output, or beside it
+      (``<stem>.failed.nc``, ``.failed-2.nc``, ...) when a file is there: never over a file.
+    A disk error (a full disk, a lost mount) becomes one OutputError that says what was lost
+    and where the last snapshot is, if there is one. Signals wait until a file is complete.
+    """
 
     def __init__(self, case: Case, output, groups: dict[str, xr.Dataset], rotation=None):
         self.case = case
         self.rotation = rotation
-        self.output = Path(output) if output is not None else None
+        self.output = None if output is None else check_output(output, case)
         self.groups = groups
         self.existed = self.output is not None and self.output.exists()
+        self.snapshot_error: OSError | None = None
 
     @property
     def partial_path(self) -> Path | None:
@@ -171,29 +241,66 @@ class _Writer:
             return None
         return self.output.with_name(self.output.stem + ".partial.nc")
 
+    def _write(self, tree: xr.DataTree, path: Path) -> None:
+        with deferred():
+            results.write_tree(tree, path)
+
     def write_increment(self, name: str, ds: xr.Dataset) -> None:
         """A readable snapshot of the run so far, beside the output (never over it)."""
         if self.output is None:
             return
+        t = f" at t = {float(ds.time[-1]):.6g} s" if ds.sizes.get("time") else ""
+        ds = ds.assign_attrs(status=f"running (snapshot{t}; the step has not finished)")
         tree = results.make_tree(self.case, {**self.groups,
                                              name: rotate_back(ds, self.rotation)},
-                                 status=f"running step '{name}'")
-        results.write_tree(tree, self.partial_path)
+                                 status=f"running step '{name}' (snapshot, not a result)")
+        try:
+            self._write(tree, self.partial_path)
+        except OSError as exc:  # the run goes on; the final write says if it fails too
+            self.snapshot_error = exc
+
+    def _lost(self, target: Path, exc: OSError, what: str) -> str:
+        reason = exc.strerror or str(exc)
+        if self.partial_path.exists():
+            kept = f"the last snapshot of the run is kept in {self.partial_path}"
+        elif self.snapshot_error is not None:
+            snap = self.snapshot_error.strerror or str(self.snapshot_error)
+            kept = f"they are lost (the snapshots could not be written either: {snap})"
+        else:
+            kept = "they are lost"
+        return f"cannot write {what} to {target}: {reason}; {kept}"
 
     def write_final(self, tree: xr.DataTree) -> None:
         if self.output is None:
             return
-        results.write_tree(tree, self.output)
-        if self.partial_path.exists():
-            self.partial_path.unlink()
+        try:
+            self._write(tree, self.output)
+        except OSError as exc:
+            raise OutputError(self._lost(self.output, exc, "the results")) from None
+        self.partial_path.unlink(missing_ok=True)
 
-    def write_failed(self, tree: xr.DataTree) -> Path | None:
-        if self.output is None:
-            return None
+    def failed_path(self) -> Path:
         target = self.output
-        if self.existed or target.exists():
-            target = self.output.with_name(self.output.stem + ".failed.nc")
-        results.write_tree(tree, target)
-        if self.partial_path.exists():
-            self.partial_path.unlink()
+        k = 1
+        while (self.existed and target == self.output) or target.exists():
+            target = self.output.with_name(
+                f"{self.output.stem}.failed{'' if k == 1 else f'-{k}'}.nc")
+            k += 1
         return target
+
+    def keep_failed(self, exc: BaseException, tree: xr.DataTree) -> None:
+        """Write the tree of a failed or interrupted run; record on ``exc`` the tree
+        (``partial``), where it went (``output_path``) or why it could not be written
+        (``output_error``)."""
+        exc.partial = tree
+        exc.output_path = None
+        if self.output is None:
+            return
+        target = self.failed_path()
+        try:
+            self._write(tree, target)
+        except OSError as err:
+            exc.output_error = self._lost(target, err, "the results computed so far")
+            return
+        exc.output_path = target
+        self.partial_path.unlink(missing_ok=True)

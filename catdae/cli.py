@@ -1,12 +1,15 @@
 """The command line: ``catdae run``, ``check``, ``plot``, ``export``, ``study``. No physics.
 
 Errors become one clear message on stderr and a non-zero exit code:
-1 analysis failed (partial results written), 2 invalid case or usage, 130 interrupted.
+1 analysis failed or results cannot be written (what was computed is written if it can be, or
+the loss is stated), 2 invalid case or usage (judged before any work), 130 interrupted by Ctrl-C
+(SIGINT), 143 stopped by SIGTERM; after an interrupt the partial results are written and marked.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from importlib.resources import files
 from pathlib import Path
@@ -14,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__
-from .errors import CaseError, CatdaeError
+from .errors import CaseError, CatdaeError, OutputError
+from .interrupts import signals_as_interrupts
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.plot.WHAT
 
@@ -76,18 +80,19 @@ def main(argv: list[str] | None = None) -> int:
         return study_main(argv[1:])
     args = _parser().parse_args(argv)
     try:
-        if args.command == "check":
-            return _check(args)
-        if args.command == "run":
-            return _run(args)
-        if args.command == "plot":
-            return _plot(args)
-        if args.command == "export":
-            return _export(args)
-        if args.command == "study":
-            from .study import main as study_main
+        with signals_as_interrupts():  # SIGTERM stops a run like Ctrl-C: partial results kept
+            if args.command == "check":
+                return _check(args)
+            if args.command == "run":
+                return _run(args)
+            if args.command == "plot":
+                return _plot(args)
+            if args.command == "export":
+                return _export(args)
+            if args.command == "study":
+                from .study import main as study_main
 
-            return study_main(list(args.rest))
+                return study_main(list(args.rest))
     except CaseError as exc:
         sep = ": " if len(exc.problems) == 1 else "\n"
         print(f"catdae: invalid case{sep}{exc}", file=sys.stderr)
@@ -95,13 +100,28 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"catdae: cannot write the results: {exc}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("catdae: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        code = getattr(exc, "exit_code", 130)
+        by = f" by {signal.Signals(code - 128).name}" if code > 128 else ""
+        print(f"catdae: interrupted{by}", file=sys.stderr)
+        _say_where(exc, "before the interrupt")
+        return code
     return 2  # pragma: no cover - argparse requires a command
 
 
+def _say_where(exc: BaseException, when: str) -> None:
+    """Where the results computed before a failure or an interrupt went, or that they are
+    lost (set on the exception by the pipeline's writer)."""
+    where = getattr(exc, "output_path", None)
+    lost = getattr(exc, "output_error", None)
+    if where is not None:
+        print(f"catdae: results computed {when} were written to {where}", file=sys.stderr)
+    elif lost is not None:
+        print(f"catdae: {lost}", file=sys.stderr)
+
+
 def _check(args) -> int:
+    from .analysis import check_steps
     from .case import load_case
     from .formfind import initial_lengths
     from .frame import to_gravity_frame
@@ -110,20 +130,23 @@ def _check(args) -> int:
     case = load_case(Path(args.case))  # the command line always names a file
     # form-found lengths: the estimates, which also reject targets an isolated cable misses
     mesh = build_mesh(initial_lengths(to_gravity_frame(case)[0]))
+    check_steps(case, mesh)
     print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
           f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
     return 0
 
 
 def _run(args) -> int:
-    from .analysis import run
+    from .analysis import check_output, run
     from .case import load_case
 
     path = Path(args.case) if args.case else default_case_path()
     case = load_case(path)
-    out = Path(args.output) if args.output else Path(f"{path.stem}.nc")
-    if not out.parent.is_dir():
-        print(f"catdae: cannot write {out}: no directory {out.parent}", file=sys.stderr)
+    out = Path(args.output) if args.output is not None else Path(f"{path.stem}.nc")
+    try:
+        check_output(args.output if args.output is not None else out, case)
+    except OutputError as exc:  # judged before any work: a usage error
+        print(f"catdae: {exc}", file=sys.stderr)
         return 2
     try:
         tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
@@ -131,11 +154,8 @@ def _run(args) -> int:
     except CaseError:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:
-        where = getattr(exc, "output_path", None)
         print(f"catdae: {path}: {exc}", file=sys.stderr)
-        if where is not None:
-            print(f"catdae: results computed before the failure were written to {where}",
-                  file=sys.stderr)
+        _say_where(exc, "before the failure")
         return 1
     print(summary(tree))
     print(f"results written to {out}")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import signal
+
 
 class CatdaeError(Exception):
     """Base class of every error catdae raises on purpose."""
@@ -36,3 +38,25 @@ class SolverError(CatdaeError):
         super().__init__(message)
         self.termination = termination
         self.partial = partial
+
+
+class OutputError(CatdaeError):
+    """The results cannot be written (a directory, no permission, a full disk, ...)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """A run stopped by a signal: SIGINT (Ctrl-C) or SIGTERM (``timeout``, batch schedulers,
+    container stops). A ``KeyboardInterrupt``, so that every layer that keeps partial results on
+    Ctrl-C keeps them on SIGTERM too; ``exit_code`` is the shell's 128 + signal number.
+
+    Like a ``CatdaeError`` of a failed run, it carries ``partial`` (what was computed) and
+    ``output_path`` (where that went) once the pipeline has written it.
+    """
+
+    def __init__(self, signum: int = signal.SIGINT):
+        self.signum = int(signum)
+        super().__init__(signal.Signals(self.signum).name)
+
+    @property
+    def exit_code(self) -> int:
+        return 128 + self.signum

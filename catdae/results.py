@@ -7,7 +7,10 @@ into place, so an existing file is only ever replaced by a complete one.
 
 from __future__ import annotations
 
+import errno
 import os
+import shutil
+import uuid
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -182,18 +185,46 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 
 
+INCOMPLETE_SUFFIX = ".incomplete"
+"""The temporary name ends so: ``<name>.<pid>-<random>.incomplete``, never ``.nc``."""
+
+
+def incomplete_name(path: Path) -> Path:
+    """The temporary file that :func:`write_atomic` writes before moving it to ``path``. Only a
+    process killed outright (SIGKILL, power loss) leaves one behind; its name says what it is
+    and no ``*.nc`` pattern matches it, so it is never taken for a result."""
+    return path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}{INCOMPLETE_SUFFIX}")
+
+
 def write_atomic(data: xr.DataTree | xr.Dataset, path: str | os.PathLike) -> Path:
-    """Write netCDF-4 atomically: a temporary file beside the target, moved over it, so that a
-    crash never leaves half a file and an existing file is only replaced by a complete one."""
+    """Write netCDF-4 atomically: a temporary file beside the target (:func:`incomplete_name`),
+    moved over it, so that a crash never leaves half a file and an existing file is only
+    replaced by a complete one. Raises OSError when the file cannot be written."""
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    tmp = incomplete_name(path)
     try:
         data.to_netcdf(tmp, engine="netcdf4")
         os.replace(tmp, path)
+    except RuntimeError as exc:  # how the netCDF/HDF5 library reports a failed write
+        tmp.unlink(missing_ok=True)
+        raise _write_failure(data, path, exc) from exc
     finally:
         if tmp.exists():
             tmp.unlink()
     return path
+
+
+def _write_failure(data, path: Path, exc: RuntimeError) -> OSError:
+    """The OSError behind a netCDF library error: ENOSPC when the disk has less room left than
+    the data needs (the library says only "HDF error"), else EIO with the library's words."""
+    try:
+        free = shutil.disk_usage(path.parent).free
+    except OSError:
+        free = None
+    if free is not None and free < data.nbytes + (1 << 20):
+        return OSError(errno.ENOSPC, f"{os.strerror(errno.ENOSPC)} ({free} bytes free, about "
+                                     f"{data.nbytes} needed)")
+    return OSError(errno.EIO, f"the netCDF library failed to write: {exc}")
 
 
 def write_tree(tree: xr.DataTree, path: str | os.PathLike) -> Path:

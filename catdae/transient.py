@@ -463,6 +463,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     n_steps = 0
     n_restarts = 0
     status = "completed"
+    interrupt = None
     k_done = 0
     bar = reporter(progress, step.name, t0, t_end)
     last_write = _time.perf_counter()
@@ -552,8 +553,9 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(step.name, dataset(k_done))
                 last_write = _time.perf_counter()
-    except KeyboardInterrupt:
-        status = f"interrupted at t = {times[k_done - 1]:.6g} s"
+    except KeyboardInterrupt as exc:  # goes on after the partial dataset is attached below
+        status = f"interrupted at t = {times[max(k_done - 1, 0)]:.6g} s"
+        interrupt = exc
     except SolverError as exc:
         status = str(exc)
     except Exception as exc:  # nothing lost: keep what was computed, say what went wrong
@@ -562,6 +564,9 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     finally:
         bar.close()
     ds = dataset(k_done)
+    if interrupt is not None:
+        interrupt.partial = ds
+        raise interrupt
     if status != "completed":
         raise SolverError(f"transient step '{step.name}': {status}", termination=status,
                           partial=ds)

@@ -570,3 +570,101 @@ def test_fuzz_mutations_of_a_valid_case(data):
         else:
             parent.append(data.draw(values))
     check_only_case_error(dump(case))
+
+
+# -- fuzzing the bundled cases: values, types and keys; only catdae's own errors escape ---------
+
+BUNDLED = {p.name: tomllib.loads(p.read_text()) for p in sorted(CASES.glob("*.toml"))}
+HOSTILE = st.sampled_from([
+    0, -1, 1, 10**6, 10**9, 2**63 - 1, -(2**63), 10**30, 0.0, -0.0, 1e-200, 5e-324, 1e-6,
+    1e6, 1e300, -1e300, 1.7976931348623157e308, "", ".", "..", "$x", "a\x00b", "c.02", "main.0",
+    "main.007", "main.99999", "/", "a/b", " ", "\t", "A", "main", "/etc/passwd", "/dev/zero",
+    "../../etc/passwd", "é", "\u0301", "x" * 300, [], {}, [[]], [0.0] * 7, True,
+]).map(copy.deepcopy)  # fresh lists and tables: a mutation must not change the strategy
+
+
+def _perturbed(v, draw):
+    """A value near the original in kind: the same number scaled, of the other number type,
+    a string edited, a list grown or shrunk."""
+    if isinstance(v, bool):
+        return not v
+    if isinstance(v, int):
+        x = v * draw(st.sampled_from([0, -1, 2, 10**3, 10**5, 10**9, 10**30]))
+        return float(x) if draw(st.booleans()) else x
+    if isinstance(v, float):
+        x = v * draw(st.sampled_from([0.0, -1.0, 10.0, 1e-9, 1e9, 1e300, 1e-300]))
+        return int(x) if abs(x) < 1e30 and draw(st.booleans()) else x
+    if isinstance(v, str):
+        return draw(st.sampled_from([v + "0", v[:-1], v.upper(), "0" + v, v + "/x", v * 2]))
+    if isinstance(v, list):
+        return v[:-1] if v and draw(st.booleans()) else v + v[-1:]
+    return v
+
+
+def _mutate(data: dict, draw) -> None:
+    paths = [p for p in all_paths(data) if p]
+    where = draw(st.sampled_from(paths))
+    parent = data
+    for k in where[:-1]:
+        parent = parent[k]
+    key = where[-1]
+    op = draw(st.sampled_from(["perturb", "perturb", "perturb", "hostile", "hostile",
+                               "hostile", "type", "delete", "add", "rename", "copy",
+                               "duplicate"]))
+    if op == "perturb":
+        parent[key] = _perturbed(parent[key], draw)
+    elif op == "hostile":
+        parent[key] = draw(HOSTILE)
+    elif op == "type":
+        parent[key] = draw(values)
+    elif op == "delete":
+        del parent[key]
+    elif op == "add":
+        new = draw(st.one_of(st.sampled_from(KEYS), HOSTILE.filter(lambda h: isinstance(h, str))))
+        if isinstance(parent, dict):
+            parent[new] = draw(st.one_of(values, HOSTILE))
+        else:
+            parent.append(draw(st.one_of(values, HOSTILE)))
+    elif op == "rename" and isinstance(parent, dict):
+        new = draw(st.one_of(st.sampled_from(KEYS), st.text(max_size=6),
+                             HOSTILE.filter(lambda h: isinstance(h, str))))
+        parent[new] = parent.pop(key)
+    elif op == "copy":  # a value from elsewhere in the case: a node name where a cable goes...
+        other = draw(st.sampled_from(paths))
+        source = data
+        for k in other:
+            source = source[k]
+        parent[key] = copy.deepcopy(source)
+    elif op == "duplicate" and isinstance(parent, list):
+        parent.append(copy.deepcopy(parent[key]))  # a second cable, step, load of that name
+
+
+def check_only_catdae_errors(text: str) -> None:
+    """What ``catdae check`` does (read, validate, mesh, judge the steps): a Case or one of
+    catdae's own errors, with every problem named."""
+    from catdae.analysis import check_steps
+    from catdae.errors import CatdaeError
+    from catdae.mesh import build_mesh
+
+    try:
+        case = load_case(text)
+        check_steps(case, build_mesh(case))
+    except CaseError as exc:
+        assert exc.problems
+        assert all(isinstance(p, str) and isinstance(m, str) and m for p, m in exc.problems)
+    except CatdaeError as exc:
+        assert str(exc)
+
+
+@settings(max_examples=250, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(data=st.data())
+def test_fuzz_mutations_of_the_bundled_cases(data):
+    """1 to 5 mutations of a bundled case: values perturbed (scaled, other number type),
+    hostile values (huge counts, degenerate durations, unsafe names, paths outside the case),
+    other types, keys deleted, added and renamed, values copied across, entries duplicated."""
+    case = copy.deepcopy(BUNDLED[data.draw(st.sampled_from(sorted(BUNDLED)))])
+    for _ in range(data.draw(st.integers(1, 5))):
+        if case:
+            _mutate(case, data.draw)
+    check_only_catdae_errors(dump(case))

@@ -26,7 +26,9 @@ explained:
 - :mod:`~catdae.case.read`: ``load_case`` and ``case_from_dict``, pass 1 (TOML);
 - :mod:`~catdae.case.schema`: pass 2, the shape and types of each item (pydantic);
 - :mod:`~catdae.case.build`: pass 3, cross references and physics, building the model;
-- :mod:`~catdae.case.messages`: how problems are worded (field paths, "expected ..., found ...").
+- :mod:`~catdae.case.messages`: how problems are worded (field paths, "expected ..., found ...");
+- :mod:`~catdae.case.limits`: counts and sizes judged before any work, and how files are read
+  (regular files only, bounded, table files confined to the case's folder).
 """
 
 from .model import (

@@ -10,15 +10,19 @@ from __future__ import annotations
 
 import csv
 import math
+import re
+import unicodedata
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from pydantic import BaseModel, ValidationError
 
 from ..errors import CaseError
 from ..frame import gravity_rotation, local_axes
 from ..timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
+from .limits import MIN_TIME, FileProblem, confined, read_limited, size_problems
 from .messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from .model import (
     AXES,
@@ -126,9 +130,10 @@ class _Builder:
         steps = self.steps(top.steps)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
+        self.names(top)
         if self.problems:
             raise CaseError(self.path, self.problems)
-        return Case(
+        case = Case(
             title=top.title, source=top.source, gravity=self.gravity,
             gravity_direction=self.gravity_direction,
             materials=FrozenMap(materials), nodes=FrozenMap(nodes),
@@ -137,6 +142,28 @@ class _Builder:
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
             steps=tuple(steps), path=self.path, text=text, name=name,
         )
+        problems = size_problems(case)  # counts and sizes, before any work
+        if problems:
+            raise CaseError(self.path, problems)
+        return case
+
+    def names(self, top: _Top) -> None:
+        """Names and texts end up in the results file: no control characters (netCDF cuts a
+        string at NUL)."""
+        found: list[tuple[tuple, str]] = [(("title",), top.title), (("source",), top.source)]
+        found += [(("materials", k), k) for k in top.materials]
+        found += [(("nodes", k), k) for k in top.nodes]
+        for section in ("cables", "point_masses", "loads", "distributed_loads"):  # steps:
+            # their names are held to the stricter rule of group names (steps())
+            found += [((section, i, "name"), item["name"]) for i, item in
+                      enumerate(getattr(top, section)) if isinstance(item.get("name"), str)]
+        for where, text in found:
+            allowed = "\n\t" if where[0] in ("title", "source") else ""
+            bad = [c for c in text if unicodedata.category(c) == "Cc" and c not in allowed]
+            if bad:
+                self.problem(where, f"expected text without control characters, found "
+                             f"{_short(text)} (U+{ord(bad[0]):04X})")
+
 
     def gravity_vector(self, raw: Any) -> tuple[float, tuple[float, float, float]]:
         """``gravity``: a number (m/s², along -z) or ``[gx, gy, gz]``; returns (|g|, unit)."""
@@ -532,9 +559,11 @@ class _Builder:
             if nm in names:
                 self.problem(where + ("name",), f"duplicate step name {nm!r} (also "
                              f"steps[{names[nm]}])")
-            elif "/" in nm:
-                self.problem(where + ("name",), f"step names may not contain '/' (they name "
-                             f"result groups), found {nm!r}")
+            elif not _group_name(nm):
+                self.problem(where + ("name",), "a step name names a group of the results "
+                             "file: expected a letter, digit or '_' first, then also '.', '-', "
+                             "'+', '@' or inner spaces (no '/'; netCDF group names), found "
+                             f"{_short(nm)}")
             names.setdefault(nm, i)
             if v is None:
                 continue
@@ -658,13 +687,20 @@ class _Builder:
         if not complete:
             return None
         if kind == "constant":
-            return Constant(float(v.value))
-        if kind == "ramp":
-            return Ramp(float(v.duration), float(v.start), v.smooth, float(v.amplitude))
-        if kind in ("sine", "cosine"):
+            tf: TimeFunction | None = Constant(float(v.value))
+        elif kind == "ramp":
+            tf = Ramp(float(v.duration), float(v.start), v.smooth, float(v.amplitude))
+        elif kind in ("sine", "cosine"):
             cls = Sine if kind == "sine" else Cosine
-            return cls(float(v.amplitude), float(v.frequency), float(v.phase), float(v.offset))
-        return self.table(v, where)
+            tf = cls(float(v.amplitude), float(v.frequency), float(v.phase), float(v.offset))
+        else:
+            tf = self.table(v, where)
+        if tf is not None and not _finite(tf):
+            self.problem(where, "its value, rate or second derivative overflows (not a "
+                         "finite number): check the amplitude against the duration or "
+                         "frequency")
+            return None
+        return tf
 
     def table(self, v: _TableTF, where: tuple) -> Table | None:
         inline = v.t is not None or v.value is not None
@@ -696,21 +732,30 @@ class _Builder:
             self.problem(at, f"expected at least 2 points, found {len(t)}")
             return None
         for j in range(1, len(t)):
-            if not t[j] > t[j - 1]:
-                self.problem(at, "expected strictly increasing times, found "
-                             f"{t[j - 1]:g} then {t[j]:g} (point {j})")
+            if not t[j] >= t[j - 1] + MIN_TIME:
+                self.problem(at, f"expected strictly increasing times, at least {MIN_TIME:g} s "
+                             "apart, "
+                             f"found {t[j - 1]:g} then {t[j]:g} (point {j})")
                 return None
         return Table(tuple(float(x) for x in t), tuple(float(x) for x in value), v.file)
 
     def read_csv(self, name: str, where: tuple) -> list[tuple[float, float]] | None:
-        """Rows ``time, value`` of a CSV file; blank and ``#`` lines skipped, one header allowed."""
-        file = self.base_dir / name
+        """Rows ``time, value`` of a CSV file; blank and ``#`` lines skipped, one header allowed.
+
+        The file must be a regular file inside the case's folder (or a folder listed in
+        CATDAE_TABLE_ROOTS) of at most MAX_FILE_BYTES; problems name the line, never quote it.
+        """
         try:
-            text = file.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            reason = getattr(exc, "strerror", None) or str(exc)
-            self.problem(where, f"cannot read table file {name!r} (looked for {str(file)!r}): "
-                         f"{reason}")
+            file = confined(name, self.base_dir)
+            raw = read_limited(file, "table file")
+        except FileProblem as exc:
+            self.problem(where, f"cannot read table file {_short(name)}: {exc}")
+            return None
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            self.problem(where, f"cannot read table file {_short(name)}: not UTF-8 text "
+                         f"(byte {exc.start})")
             return None
         rows = []
         for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
@@ -724,12 +769,14 @@ class _Builder:
             if pair is None:
                 if not rows and lineno == 1:
                     continue  # a header line such as "time,value"
-                self.problem(where, f"{name}, line {lineno}: expected two numbers 'time,value', "
-                             f"found {_short(','.join(row))}")
+                found = (f"{len(cells)} field(s)" if len(cells) != 2
+                         else "a field that is not a number")
+                self.problem(where, f"{_short(name)}, line {lineno}: expected two "
+                             f"numbers 'time,value', found {found}")
                 return None
             if not all(math.isfinite(x) for x in pair):
-                self.problem(where, f"{name}, line {lineno}: expected finite numbers, found "
-                             f"{_short(','.join(row))}")
+                self.problem(where, f"{_short(name)}, line {lineno}: expected finite "
+                             "numbers, found inf or nan")
                 return None
             rows.append(pair)
         return rows
@@ -745,6 +792,8 @@ class _Builder:
             if (materials[c.material].weight > 0 or name in loaded or c.length is None
                     or not all(e in nodes for e in c.ends)):  # bad ends: already reported
                 continue
+            if c.ends[0] not in nodes or c.ends[1] not in nodes:
+                continue  # an end's coordinates are bad, and already reported
             chord = math.dist(nodes[c.ends[0]], nodes[c.ends[1]])
             if c.length >= chord:
                 self.problem(("cables", i, "length"), (
@@ -761,9 +810,38 @@ def _mesh_node_problem(ref: str, elements: Mapping[str, int]) -> str | None:
         return _unknown(ref, "node", sorted(elements))
     n = elements[cable]
     if k.isdigit() and k.isascii() and 1 <= int(k) <= n - 1:
-        return None
+        if k == str(int(k)):
+            return None
+        return (f"mesh node {ref!r} is written with a leading zero: its name is "
+                f"'{cable}.{int(k)}'")
     if n == 1:
         return (f"mesh node {ref!r} does not exist: cable {cable!r} has 1 element and so no "
                 "interior mesh nodes")
     return (f"mesh node {ref!r} does not exist: cable {cable!r} has {n} elements, so its mesh "
             f"nodes are {cable}.1 .. {cable}.{n - 1}")
+
+
+_GROUP_NAME = re.compile(r"\w[\w.+\-@ ]*")
+
+
+def _group_name(name: str) -> bool:
+    """A netCDF-4 group name that reads back as written: a letter, digit or '_' first (not
+    '$', '.', '-'), no '/', no trailing space, NFC, at most 255 bytes."""
+    return (_GROUP_NAME.fullmatch(name) is not None and not name.endswith(" ")
+            and unicodedata.is_normalized("NFC", name) and len(name.encode()) <= 255)
+
+
+def _finite(tf: TimeFunction) -> bool:
+    """f, f' and f'' finite where they are largest: at 0, the breakpoints, inside a ramp
+    (f'' peaks at x = 0.21 and 0.79), at a quarter period, at a table's points and between."""
+    ts = [0.0, *tf.breakpoints()]
+    if isinstance(tf, Ramp):
+        ts += [tf.start + tf.duration * x for x in (0.2113, 0.5, 0.7887)]
+    elif isinstance(tf, Sine | Cosine):
+        ts += [0.25 / tf.frequency, 0.5 / tf.frequency]
+    elif isinstance(tf, Table):
+        t = np.asarray(tf.t)
+        ts += [*t, *(0.5 * (t[1:] + t[:-1]))]
+    with np.errstate(all="ignore"):
+        values = tf.evaluate(np.asarray(ts, float))
+    return all(np.isfinite(v).all() for v in values)

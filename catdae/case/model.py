@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 from ..errors import CaseError
 from ..timefunc import TimeFunction
+from .limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from .messages import _found, _is_number
 
 AXES = ("x", "y", "z")
@@ -285,9 +286,10 @@ class Case:
                 problems.append((key, f"expected a finite number > 0, found {_found(value)}"))
         if elements is not None and not (
             isinstance(elements, numbers.Integral) and not isinstance(elements, bool)
-            and elements >= 1
+            and 1 <= elements <= MAX_ELEMENTS_PER_CABLE
         ):
-            problems.append(("elements", f"expected an integer >= 1, found {_found(elements)}"))
+            problems.append(("elements", f"expected an integer >= 1 and <= "
+                             f"{MAX_ELEMENTS_PER_CABLE}, found {_found(elements)}"))
         if mass_model is not None and mass_model not in ("consistent", "lumped", "linear"):
             problems.append(("mass_model", 'expected "consistent", "lumped" or "linear", '
                              f"found {_found(mass_model)}"))
@@ -329,5 +331,9 @@ class Case:
 
             point_masses = tuple(keep_place(p) for p in point_masses)
             loads = tuple(keep_place(p) for p in loads)
-        return replace(self, steps=steps, cables=cables, point_masses=point_masses,
+        case = replace(self, steps=steps, cables=cables, point_masses=point_masses,
                        loads=loads)
+        problems = size_problems(case)  # more elements: the limits are judged again
+        if problems:
+            raise CaseError(self.path, problems)
+        return case

@@ -11,6 +11,7 @@ from typing import Any
 
 from ..errors import CaseError
 from .build import _Builder
+from .limits import FileProblem, read_limited
 from .messages import _found
 from .model import Case
 
@@ -27,10 +28,9 @@ def load_case(path_or_text: str | os.PathLike, *, name: str | None = None) -> Ca
     if isinstance(path_or_text, os.PathLike) or _looks_like_path(path_or_text):
         path = os.fspath(path_or_text)
         try:
-            raw = Path(path).read_bytes()
-        except OSError as exc:
-            reason = exc.strerror or str(exc)
-            raise CaseError(path, [("", f"cannot read the case file: {reason}")]) from None
+            raw = read_limited(Path(path), "case file")
+        except FileProblem as exc:
+            raise CaseError(path, [("", f"cannot read the case file: {exc}")]) from None
         try:
             text = raw.decode("utf-8")
         except UnicodeDecodeError as exc:

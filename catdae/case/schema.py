@@ -11,10 +11,14 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
+from .limits import MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
+
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
 Pos = Annotated[float, Field(gt=0)]
 NonNeg = Annotated[float, Field(ge=0)]
+Time = Annotated[float, Field(ge=MIN_TIME)]  # s: shorter is degenerate (0/0 in a ramp)
+Frequency = Annotated[float, Field(gt=0, le=MAX_FREQUENCY)]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Name = Annotated[str, Field(min_length=1)]
 TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
@@ -52,7 +56,7 @@ class _Cable(BaseModel):
     material: Name
     length: Pos | None = None  # exactly one of length and form (checked by the builder)
     form: TomlTable | None = None
-    elements: Annotated[int, Field(ge=1)] = 1
+    elements: Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)] = 1
     gauss_points: Annotated[int, Field(ge=1, le=10)] = 3
 
 
@@ -116,8 +120,8 @@ class _TransientStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
-    duration: Pos
-    output_interval: Pos
+    duration: Time
+    output_interval: Time
     rtol: Pos = 1e-6
     atol: Pos = 1e-8
     damping: TomlTable | None = None
@@ -173,7 +177,7 @@ class _ConstantTF(BaseModel):
 class _RampTF(BaseModel):
     model_config = _STRICT
     kind: Literal["ramp"]
-    duration: Pos
+    duration: Time
     start: float = 0.0
     smooth: bool = False
     amplitude: float = 1.0
@@ -183,7 +187,7 @@ class _SineTF(BaseModel):
     model_config = _STRICT
     kind: Literal["sine", "cosine"]
     amplitude: float
-    frequency: Pos
+    frequency: Frequency
     phase: float = 0.0
     offset: float = 0.0
 

@@ -1,0 +1,72 @@
+"""SIGINT and SIGTERM as one exception, so that a stopped run keeps and marks what it computed.
+
+``catdae run`` installs :func:`signals_as_interrupts` around the pipeline: either signal raises
+:class:`~catdae.errors.Interrupted` (a ``KeyboardInterrupt``) in the main thread, which every step
+turns into partial results with a status saying where it stopped. Once one is raised, further
+signals are ignored until the context ends, so that a second Ctrl-C cannot cut short the writing
+of the partial results; and inside :func:`deferred` (the writers) a signal waits until the file is
+complete. Without the context (``catdae.run`` in a user's program) Python's own Ctrl-C handling
+is left alone and :func:`deferred` does nothing.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+from .errors import Interrupted
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class _State:
+    installed = False
+    stopping = False  # an Interrupted has been raised: ignore further signals
+    deferring = 0  # depth of deferred() blocks
+    pending: int | None = None  # a signal received inside deferred()
+
+
+def _handler(signum, frame):
+    if _State.stopping:
+        return
+    if _State.deferring:
+        _State.pending = signum
+        return
+    _State.stopping = True
+    raise Interrupted(signum)
+
+
+@contextmanager
+def signals_as_interrupts() -> Iterator[None]:
+    """SIGINT and SIGTERM raise Interrupted inside the block (main thread only; elsewhere a
+    no-op). The previous handlers are restored afterwards."""
+    if threading.current_thread() is not threading.main_thread() or _State.installed:
+        yield
+        return
+    previous = {s: signal.getsignal(s) for s in SIGNALS}
+    _State.installed, _State.stopping, _State.pending = True, False, None
+    try:
+        for s in SIGNALS:
+            signal.signal(s, _handler)
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
+        _State.installed, _State.stopping, _State.pending = False, False, None
+
+
+@contextmanager
+def deferred() -> Iterator[None]:
+    """A signal that arrives inside the block is raised when the block ends, not in it: a file
+    being written is finished first (with the handlers of :func:`signals_as_interrupts`)."""
+    _State.deferring += 1
+    try:
+        yield
+    finally:
+        _State.deferring -= 1
+    if not _State.deferring and _State.pending is not None and not _State.stopping:
+        signum, _State.pending = _State.pending, None
+        _State.stopping = True
+        raise Interrupted(signum)
