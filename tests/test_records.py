@@ -1,0 +1,90 @@
+"""Ground-motion records against analytic motions: the record's own samples are kept, and the
+displacement converges at the order the interpolation claims (catdae/records.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from catdae.records import AccelerationRecord, VelocityRecord
+
+A, W = 0.05, 2.0 * math.pi * 1.3  # m, rad/s
+
+
+def motion(t):
+    """u = A (1 - cos ωt): starts from rest at u = 0 (the acceleration A ω² jumps on at t = 0)."""
+    return A * (1 - np.cos(W * t)), A * W * np.sin(W * t), A * W**2 * np.cos(W * t)
+
+
+def sampled(cls, dt, duration=2.0, which=2):
+    ts = np.linspace(0.0, duration, int(round(duration / dt)) + 1)
+    return cls(tuple(ts), tuple(motion(ts)[which])), ts
+
+
+def max_errors(rec, duration=2.0):
+    t = np.linspace(0.0, duration, 4001)
+    got = rec.evaluate(t)
+    exact = motion(t)
+    return [float(np.max(np.abs(g - e))) for g, e in zip(got, exact, strict=True)]
+
+
+def order(cls, which, dts):
+    errs = np.array([max_errors(sampled(cls, dt, which=which)[0]) for dt in dts])  # (k, 3)
+    return [float(np.polyfit(np.log(dts), np.log(errs[:, j]), 1)[0]) for j in range(3)], errs
+
+
+def test_acceleration_record_keeps_its_samples_and_starts_from_rest():
+    rec, ts = sampled(AccelerationRecord, 0.05)
+    u, v, a = rec.evaluate(ts)
+    np.testing.assert_allclose(a, motion(ts)[2], rtol=0, atol=1e-13 * A * W**2)
+    assert rec.evaluate(-0.1) == (0.0, 0.0, 0.0)
+    assert rec.evaluate(0.0)[:2] == (0.0, 0.0)
+    # between samples the acceleration stays between its neighbours (no overshoot)
+    mid = 0.5 * (ts[1:] + ts[:-1])
+    am = rec.evaluate(mid)[2]
+    lo = np.minimum(motion(ts)[2][1:], motion(ts)[2][:-1])
+    hi = np.maximum(motion(ts)[2][1:], motion(ts)[2][:-1])
+    assert np.all((am >= lo - 1e-12) & (am <= hi + 1e-12))
+    # derivatives consistent: central differences of u and v
+    h = 1e-6
+    for tk in (0.0137, 0.731, 1.42):
+        up, vp, _ = rec.evaluate(tk + h)
+        um, vm, _ = rec.evaluate(tk - h)
+        _, v0, a0 = rec.evaluate(tk)
+        assert (up - um) / (2 * h) == pytest.approx(v0, rel=1e-7)
+        assert (vp - vm) / (2 * h) == pytest.approx(a0, rel=1e-6)
+    assert rec.breakpoints() == (0.0, 2.0)  # the acceleration jumps on and off
+
+
+def test_acceleration_record_converges_at_second_order():
+    dts = np.array([0.04, 0.02, 0.01, 0.005])
+    rates, errs = order(AccelerationRecord, 2, dts)
+    # displacement and velocity: the piecewise-linear interpolation error, integrated
+    assert rates[0] == pytest.approx(2.0, abs=0.1), errs[:, 0]
+    assert rates[1] == pytest.approx(2.0, abs=0.1), errs[:, 1]
+    # and its size: the trapezoid-rule error of each interval, Δt² a''/12 on average, integrated
+    # twice for u = A (1 - cos ωt) gives Δt² A ω² (1 - cos ωt)/12 <= Δt² A ω²/6
+    bound = dts**2 * A * W**2 / 6
+    assert np.all(errs[:, 0] <= 1.05 * bound) and np.all(errs[:, 0] >= 0.8 * bound), errs[:, 0]
+
+
+def test_velocity_record_converges_at_fourth_order():
+    dts = np.array([0.04, 0.02, 0.01, 0.005])
+    rates, errs = order(VelocityRecord, 1, dts)
+    assert rates[0] == pytest.approx(4.0, abs=0.3), errs[:, 0]
+    assert rates[1] == pytest.approx(4.0, abs=0.3), errs[:, 1]
+    assert rates[2] == pytest.approx(3.0, abs=0.3), errs[:, 2]
+    rec, ts = sampled(VelocityRecord, 0.05, which=1)
+    np.testing.assert_allclose(rec.evaluate(ts)[1], motion(ts)[1], atol=1e-13 * A * W)
+
+
+def test_after_the_record_the_support_keeps_its_last_velocity():
+    # a constant acceleration for 1 s: v = g t, u = g t²/2; then it coasts at v = g
+    rec = AccelerationRecord((0.0, 1.0), (9.81, 9.81))
+    assert rec.evaluate(1.0) == pytest.approx((9.81 / 2, 9.81, 9.81))
+    assert rec.evaluate(3.0) == pytest.approx((9.81 / 2 + 2 * 9.81, 9.81, 0.0))
+    vel = VelocityRecord((0.5, 1.5), (2.0, 2.0))
+    assert vel.evaluate(0.4) == (0.0, 0.0, 0.0)
+    assert vel.evaluate(2.5) == pytest.approx((4.0, 2.0, 0.0))
