@@ -57,11 +57,13 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     state = _State(mesh.X0.copy())
     groups: dict[str, xr.Dataset] = {}
     steps = case.steps or (Step(kind="static", name="static"),)
-    removed: set[str] = set()
+    # what a step leaves out: the items not yet added (active = false) and those removed
+    absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
+              if not x.active}
     writer = _Writer(case, output, groups)
     for step in steps:
-        removed |= set(step.remove)
-        model = Model(case, mesh, removed, mass_model=step.mass_model)
+        absent = (absent - set(step.add)) | set(step.remove)
+        model = Model(case, mesh, absent, mass_model=step.mass_model)
         try:
             ds = _run_step(step, model, state, writer, progress)
         except KeyboardInterrupt:

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+import catdae
 from catdae.records import AccelerationRecord, VelocityRecord
 
 A, W = 0.05, 2.0 * math.pi * 1.3  # m, rad/s
@@ -88,3 +89,87 @@ def test_after_the_record_the_support_keeps_its_last_velocity():
     vel = VelocityRecord((0.5, 1.5), (2.0, 2.0))
     assert vel.evaluate(0.4) == (0.0, 0.0, 0.0)
     assert vel.evaluate(2.5) == pytest.approx((4.0, 2.0, 0.0))
+
+
+# ---------------------------------------------------------------------------------------------
+# Through the case format: a support driven by an acceleration record in a multi-column CSV
+# ---------------------------------------------------------------------------------------------
+def record_scene(tmp_path, dt, motion_line):
+    """The taut string with a heavy midspan mass of tests/test_loads.py, support A moving in y."""
+    from scenes import cable_scene, transient_step
+
+    ts = np.linspace(0.0, 1.0, int(round(1.0 / dt)) + 1)
+    u, v, a = motion(ts)
+    rows = "\n".join(f"{float(tk)!r},0.0,{float(ak)!r},{float(vk)!r}"
+                     for tk, ak, vk in zip(ts, a, v, strict=True))
+    (tmp_path / "record.csv").write_text("# a synthetic record\nt,ax,ay,vy\n" + rows + "\n")
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=9.99, EA=1e7, mass=0.01, elements=2, gravity=0.0,
+                       extra=('[[point_masses]]\nname = "M"\nnode = "c.1"\nmass = 100.0\n'
+                              f'[[support_motions]]\nnode = "A"\ny = {motion_line}\n'),
+                       steps=transient_step("shake", 1.0, 0.01, rtol=1e-9, atol=1e-12))
+    case = tmp_path / f"shake-{dt}.toml"
+    case.write_text(text)
+    return catdae.run(case)["shake"].ds
+
+
+def test_acceleration_record_drives_the_support_as_its_analytic_motion(tmp_path):
+    exact = record_scene(tmp_path, 0.01, f"{{ kind = \"cosine\", amplitude = {-A!r}, "
+                                         f"frequency = {W / (2 * math.pi)!r}, offset = {A!r} }}")
+    t = exact["time"].values
+    np.testing.assert_allclose(exact["displacement"].sel(node="A", axis="y"), motion(t)[0],
+                               atol=1e-15)
+    line = '{ kind = "table", file = "record.csv", column = "ay", quantity = "acceleration" }'
+    errs_a, errs_m = [], []
+    dts = np.array([0.02, 0.01, 0.005])
+    for dt in dts:
+        ds = record_scene(tmp_path, dt, line)
+        ua = ds["displacement"].sel(node="A", axis="y").values
+        # the support follows the integrated record: within the interpolation bound
+        errs_a.append(np.abs(ua - motion(t)[0]).max())
+        assert errs_a[-1] <= 1.05 * dt**2 * A * W**2 / 6
+        # and it starts from rest at the case position
+        assert ua[0] == 0.0 and ds["velocity"].sel(node="A", axis="y").values[0] == 0.0
+        um = ds["displacement"].sel(node="c.1", axis="y").values
+        errs_m.append(np.abs(um - exact["displacement"].sel(node="c.1", axis="y").values).max())
+    # the cable's response converges to the analytic motion's at the record's order
+    assert np.polyfit(np.log(dts), np.log(errs_a), 1)[0] == pytest.approx(2.0, abs=0.1)
+    assert np.polyfit(np.log(dts), np.log(errs_m), 1)[0] == pytest.approx(2.0, abs=0.2), errs_m
+
+
+def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
+    from scenes import cable_scene, transient_step
+
+    from catdae.cli import main
+
+    (tmp_path / "three.csv").write_text("t,ax,ay\n0.0,0.0,1.0\n1.0,0.0,2.0\n")
+    (tmp_path / "bare.csv").write_text("0.0,0.0,1.0\n1.0,0.0,2.0\n")
+    motions = [
+        ('x = { kind = "table", file = "three.csv", column = "ayy", quantity = "acceleration" }',
+         "support_motions[0].x.column: three.csv has no column 'ayy'; did you mean 'ay'? (its "
+         "columns: t, ax, ay; time is the first)"),
+        ('x = { kind = "table", file = "three.csv" }',
+         "support_motions[0].x.file: three.csv has 3 columns (t, ax, ay): choose the value "
+         'column with column = "<name>"'),
+        ('x = { kind = "table", file = "bare.csv", column = "ax" }',
+         "support_motions[0].x.column: column = 'ax' needs a header line in bare.csv"),
+        ('x = { kind = "table", t = [0.0, 1.0], value = [0.0, 1.0], column = "ax" }',
+         "support_motions[0].x.column: column selects a column of a table file"),
+        ('x = { kind = "table", file = "three.csv", column = "t" }',
+         "support_motions[0].x.column: 't' is the time column"),
+        ('x = { kind = "table", file = "three.csv", column = "ax", quantity = "jerk" }',
+         "support_motions[0].x.quantity:"),
+    ]
+    for line, message in motions:
+        case = tmp_path / "bad.toml"
+        case.write_text(cable_scene(
+            B=(10.0, 0.0, 0.0), L0=10.2, EA=1e7, mass=1.0, elements=2,
+            extra=f'[[support_motions]]\nnode = "A"\n{line}\n'
+                  '[[loads]]\nname = "P"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+                  'time = { kind = "table", t = [0.0, 1.0], value = [0.0, 1.0], '
+                  'quantity = "velocity" }\n',
+            steps=transient_step("s", 1.0, 0.1, rtol=1e-6, atol=1e-8)))
+        assert main(["check", str(case)]) == 2
+        err = capsys.readouterr().err
+        assert f"{case}: {message}" in err, err
+        assert (f"{case}: loads[0].time.quantity: quantity = 'velocity' applies to support "
+                "motions only") in err

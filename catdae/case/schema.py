@@ -61,6 +61,7 @@ class _PointMass(BaseModel):
     node: Name | None = None
     cable: Name | None = None
     s: NonNeg | None = None
+    active: bool = True
 
 
 class _Load(BaseModel):
@@ -71,6 +72,7 @@ class _Load(BaseModel):
     cable: Name | None = None
     s: NonNeg | None = None
     time: TomlTable | None = None
+    active: bool = True
 
 
 class _DistributedLoad(BaseModel):
@@ -79,6 +81,9 @@ class _DistributedLoad(BaseModel):
     cable: Name
     load: Vec3
     time: TomlTable | None = None
+    from_s: NonNeg | None = None  # m, unstrained arc length; default 0
+    to_s: Pos | None = None  # m; default the cable's length
+    active: bool = True
 
 
 class _SupportMotion(BaseModel):
@@ -94,6 +99,7 @@ class _StaticStep(BaseModel):
     kind: Literal["static"]
     name: Name | None = None
     remove: list[Name] = []
+    add: list[Name] = []
     load_steps: Annotated[int, Field(ge=1)] = 1
 
 
@@ -102,6 +108,7 @@ class _ModalStep(BaseModel):
     kind: Literal["modal"]
     name: Name | None = None
     remove: list[Name] = []
+    add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
 
@@ -111,6 +118,7 @@ class _TransientStep(BaseModel):
     kind: Literal["transient"]
     name: Name | None = None
     remove: list[Name] = []
+    add: list[Name] = []
     duration: Pos
     output_interval: Pos
     rtol: Pos = 1e-6
@@ -176,6 +184,8 @@ class _TableTF(BaseModel):
     file: Name | None = None
     t: list[float] | None = None
     value: list[float] | None = None
+    column: Name | None = None  # a named column of a CSV file with several
+    quantity: Literal["displacement", "velocity", "acceleration"] = "displacement"
 
 
 _TIME_MODELS: dict[str, type[BaseModel]] = {
