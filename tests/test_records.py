@@ -173,3 +173,28 @@ def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
         assert f"{case}: {message}" in err, err
         assert (f"{case}: loads[0].time.quantity: quantity = 'velocity' applies to support "
                 "motions only") in err
+
+
+def test_velocity_and_displacement_columns_through_the_case_format(tmp_path):
+    from scenes import cable_scene, static_step
+
+    ts = np.linspace(0.0, 1.0, 101)
+    u, v, a = motion(ts)
+    rows = "\n".join(",".join(repr(float(x)) for x in r) for r in zip(ts, u, v, a, strict=True))
+    (tmp_path / "m.csv").write_text("time,ux,vx,ax\n" + rows + "\n")
+    extra = ('[[support_motions]]\nnode = "A"\n'
+             'x = { kind = "table", file = "m.csv", column = "vx", quantity = "velocity" }\n'
+             'y = { kind = "table", file = "m.csv", column = "ux" }\n'
+             'z = { kind = "table", file = "m.csv", column = "ax", quantity = "acceleration" }\n')
+    case_file = tmp_path / "c.toml"
+    case_file.write_text(cable_scene(B=(10.0, 0.0, 0.0), L0=10.2, EA=1e7, mass=1.0, elements=2,
+                                     extra=extra, steps=static_step()))
+    sm = catdae.load_case(case_file).support_motions[0]
+    assert isinstance(sm.x, VelocityRecord) and isinstance(sm.z, AccelerationRecord)
+    np.testing.assert_allclose(sm.x.evaluate(ts)[1], v, atol=1e-13 * A * W)  # its own samples
+    np.testing.assert_allclose(sm.y(ts[:-1]), u[:-1], atol=1e-15)  # the displacement table
+    np.testing.assert_allclose(sm.z.evaluate(ts)[2], a, atol=1e-13 * A * W**2)
+    # the three descriptions of one motion agree, to the accuracy of each
+    t = np.linspace(0.0, 0.99, 97)
+    assert np.abs(sm.x(t) - motion(t)[0]).max() < 1e-6 * A  # O(Δt⁴): 1.2e-7 A measured
+    assert np.abs(sm.z(t) - motion(t)[0]).max() < 1.05 * 0.01**2 * A * W**2 / 6
