@@ -64,19 +64,21 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     state = _State(mesh.X0.copy())
     groups: dict[str, xr.Dataset] = {}
     steps = case.steps or (Step(kind="static", name="static"),)
-    removed: set[str] = set()
+    # what a step leaves out: the items not yet added (active = false) and those removed
+    absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
+              if not x.active}
     temperature: float | dict = 0.0
     writer = _Writer(case, output, groups, rotation)
     for step in steps:
-        removed |= set(step.remove)
+        absent = (absent - set(step.add)) | set(step.remove)
         if step.temperature_change is not None:
             temperature = step.temperature_change
         try:
             if find_forms and step.kind == "static":
-                local, mesh, model, ds = _form_step(step, local, removed, temperature, state)
+                local, mesh, model, ds = _form_step(step, local, absent, temperature, state)
                 find_forms = False
             else:
-                model = Model(local, mesh.heated(local, temperature), removed,
+                model = Model(local, mesh.heated(local, temperature), absent,
                               mass_model=step.mass_model)
                 ds = _run_step(step, model, state, writer, progress)
             ds = rotate_back(ds, rotation)
@@ -117,12 +119,13 @@ def check_steps(case: Case, mesh) -> None:
     Raises CaseError with the step's field path.
     """
     problems = []
-    removed: set[str] = set()
+    absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
+              if not x.active}
     for i, step in enumerate(case.steps):
-        removed |= set(step.remove)
+        absent = (absent - set(step.add)) | set(step.remove)
         if step.kind != "transient":
             continue
-        model = Model(case, mesh, removed, mass_model=step.mass_model)
+        model = Model(case, mesh, absent, mass_model=step.mass_model)
         massless = model.lumped_mass_diag().reshape(-1, 3)[:, 0] <= 0.0
         free = ~model.fixed_mask.all(axis=1)
         names = [mesh.node_names[k] for k in np.flatnonzero(massless & free)]

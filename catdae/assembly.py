@@ -1,9 +1,10 @@
 """DOF map, loading of a step, and sparse scatter of element vectors and matrices.
 
 Degrees of freedom are node-major: dof = 3 * node + axis. A :class:`Model` is what one analysis
-step sees: the mesh, the point masses and loads that are active in it (``remove`` takes some
-away), the supports and their prescribed motion. It contains only what the scene has: no time
-functions when no load varies, no internal loads when none sit inside an element.
+step sees: the mesh, the point masses and loads present in it (``active = false`` leaves one out
+until a step's ``add``, ``remove`` takes one away), the supports and their prescribed motion. It
+contains only what the scene has: no time functions when no load varies, no internal loads when
+none sit inside an element.
 """
 
 from __future__ import annotations
@@ -78,8 +79,9 @@ class Loading:
     names: tuple[str, ...] = field(default=())
 
 
-def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
-    """Collect the point masses, point loads and distributed loads active in a step."""
+def build_loading(case: Case, mesh: Mesh, absent: set[str]) -> Loading:
+    """Collect the point masses, point loads and distributed loads of a step: all but those
+    named in ``absent`` (not yet added, or removed)."""
     g = case.gravity
     nn, ne = mesh.n_nodes, mesh.n_elements
     node_mass = np.zeros(nn)
@@ -95,7 +97,7 @@ def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
         return mesh.locate(obj.cable, obj.s)
 
     for pm in case.point_masses:
-        if pm.name in removed:
+        if pm.name in absent:
             continue
         names.append(pm.name)
         kind, idx, s = where(pm)
@@ -109,7 +111,7 @@ def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
             m_s.append(s)
             m_v.append(pm.mass)
     for ld in case.loads:
-        if ld.name in removed:
+        if ld.name in absent:
             continue
         names.append(ld.name)
         kind, idx, s = where(ld)
@@ -123,15 +125,20 @@ def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
                 node_timed[id(ld)] = (ld.time, arr)
         else:
             items.append((idx, s, f, ld.time))
-    sg, wg = mesh.gauss()
     for dl in case.distributed_loads:
-        ci = mesh.cable_names.index(dl.cable)
+        if dl.name in absent:
+            continue
+        names.append(dl.name)
+        # Gauss points on the covered part of each element (§5), split at the coverage ends
         p = np.asarray(dl.load, float)
-        for e in np.flatnonzero(mesh.cable_of_element == ci):
-            for k in range(int(mesh.gauss_points[e])):
-                # p is per metre of unstrained cable at the reference temperature
-                f = wg[e, k] * mesh.L0[e] / mesh.thermal[e] * p
-                items.append((int(e), float(sg[e, k]), f, dl.time))
+        # heated cables (mesh.thermal = 1 + α ΔT, uniform along a cable): the coverage is given
+        # in unstrained arc length at the reference temperature, p per metre of it
+        ci = mesh.cable_names.index(dl.cable)
+        on = np.flatnonzero(mesh.cable_of_element == ci)
+        fc = float(mesh.thermal[on[0]]) if on.size else 1.0
+        elems, s_loc, ds = mesh.coverage_points(dl.cable, dl.from_s * fc, dl.to_s * fc)
+        for e, s, d in zip(elems, s_loc, ds, strict=True):
+            items.append((int(e), float(s), d / mesh.thermal[e] * p, dl.time))
     # CSR of internal loads, sorted by element then s
     items.sort(key=lambda it: (it[0], it[1]))
     counts = np.bincount([it[0] for it in items], minlength=ne) if items else np.zeros(ne, int)
@@ -165,10 +172,11 @@ def build_loading(case: Case, mesh: Mesh, removed: set[str]) -> Loading:
 class Model:
     """What one analysis step sees: mesh, active loading, supports and their motion."""
 
-    def __init__(self, case: Case, mesh: Mesh, removed: set[str], mass_model: str = "consistent"):
+    def __init__(self, case: Case, mesh: Mesh, absent: set[str], mass_model: str = "consistent"):
+        """``absent``: names of the point masses and loads not present in this step."""
         self.case = case
         self.mesh = mesh
-        self.loading = build_loading(case, mesh, removed)
+        self.loading = build_loading(case, mesh, absent)
         self.mass_model = mass_model
         nn = mesh.n_nodes
         self.n_dof = 3 * nn

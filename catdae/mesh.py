@@ -109,6 +109,33 @@ class Mesh:
                 return "element", int(e), s - starts[k]
         return "node", int(self.conn[elems[-1], 1]), 0.0  # pragma: no cover - s clipped above
 
+    def coverage_points(self, cable: str, from_s: float, to_s: float
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Gauss-Legendre points of the part [from_s, to_s] (unstrained arc length, m) of a cable.
+
+        Every element that the part overlaps gets its own ``gauss_points`` points on the overlap
+        alone (formulation.md §5 on the covered sub-interval): the integration is split at the
+        ends of the coverage, so a load ending inside an element is integrated as accurately as
+        one covering it whole, which is then the element's usual rule. Returns the element of
+        each point (k,) int, its local arc length (k,) m and its weight times the overlap length
+        (k,) m: the point load of a load p per metre is ``ds * p``.
+        """
+        ci = self.cable_names.index(cable)
+        elems, s_loc, ds = [], [], []
+        for e in np.flatnonzero(self.cable_of_element == ci):
+            a = max(from_s - self.s_start[e], 0.0)
+            b = min(to_s - self.s_start[e], self.L0[e])
+            if b - a <= 1e-12 * self.L0[e]:
+                continue
+            xi, wi = np.polynomial.legendre.leggauss(int(self.gauss_points[e]))
+            elems.append(np.full(xi.size, e))
+            s_loc.append(a + 0.5 * (xi + 1.0) * (b - a))
+            ds.append(0.5 * wi * (b - a))
+        if not elems:
+            return np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
+        return (np.concatenate(elems).astype(np.int64), np.concatenate(s_loc),
+                np.concatenate(ds))
+
     def elements(self, loads: PointLoads | None = None) -> Elements:
         return Elements(self.L0, self.EA, self.w, loads)
 

@@ -324,3 +324,51 @@ def irvine_caughey_frequencies(span: float, H: float, m: float, w: float, EA: fl
 def taut_string_frequencies(span: float, T: float, m: float, n: int = 3) -> np.ndarray:
     """Frequencies [Hz] of a weightless taut string: f_k = k / (2 l) sqrt(T/m), k = 1..n."""
     return np.arange(1, n + 1) * math.sqrt(T / m) / (2.0 * span)
+
+
+# --------------------------------------------------------------------------------------------------
+# 2-D elastic catenary with a weight per length that changes along the cable
+# --------------------------------------------------------------------------------------------------
+def piecewise_catenary(span: float, dz: float, EA: float, pieces) -> dict:
+    """Elastic catenary from i = (0, 0) to j = (span, dz) whose weight per unstrained length is
+    constant on each of ``pieces`` = [(L_k, w_k), ...] (in order from i, w_k > 0): self-weight
+    plus a vertical load over part of the cable, for instance.
+
+    Each piece is the closed form ``_segment`` started with the vertical tension at its start,
+    u continuing from piece to piece (u_b = u_a + w_k L_k); H is constant. (H, V_i) solve the two
+    end conditions by ``scipy.optimize.root`` from the uniform catenary of the mean weight.
+    Returns ``H``, ``V_i``, ``V_j`` (tension vector along increasing s, as in
+    ``irvine_catenary``), ``position`` (s -> (x, z)) and ``residual`` (m).
+    """
+    from scipy.optimize import root
+
+    L = np.array([p[0] for p in pieces], float)
+    w = np.array([p[1] for p in pieces], float)
+    starts = np.concatenate([[0.0], np.cumsum(L)])
+
+    def position(s, H, V):
+        s = float(s)
+        x = z = 0.0
+        u = V
+        for k in range(L.size):
+            part = min(max(s - starts[k], 0.0), L[k])
+            dx, dzk = _segment(H, u, part, w[k], EA)
+            x, z, u = x + float(dx), z + float(dzk), u + w[k] * L[k]
+        return x, z
+
+    total = float(L.sum())
+    mean = irvine_catenary(span, dz, total, EA, float((w * L).sum() / total))
+    scale = (mean["H"], abs(mean["V_i"]) + mean["H"])
+
+    def ends(y):
+        H, V = y[0] * scale[0], y[1] * scale[1]
+        xe, ze = position(total, H, V)
+        return [(xe - span) / span, (ze - dz) / span]
+
+    sol = root(ends, [1.0, mean["V_i"] / scale[1]], method="hybr", tol=1e-15)
+    H, V = sol.x[0] * scale[0], sol.x[1] * scale[1]
+    residual = float(np.max(np.abs(ends(sol.x)))) * span
+    if residual > 1e-11 * span:
+        raise RuntimeError(f"piecewise catenary residual {residual:.3e} m too large")
+    return {"H": H, "V_i": V, "V_j": V + float((w * L).sum()),
+            "position": lambda s: position(s, H, V), "residual": residual}

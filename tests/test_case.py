@@ -354,7 +354,7 @@ def test_malformed_toml_gives_line_and_column():
      ["node 'B' is not supported"]),
     ({"support_motions/0/y": None}, "support_motions[0]", ["at least one of x, y, z"]),
     ({"steps/1/remove": ["hugn"]}, "steps[1].remove[0]",
-     ["unknown point mass or load 'hugn'", "did you mean 'hung'"]),
+     ["unknown point mass, load or distributed load 'hugn'", "did you mean 'hung'"]),
     ({"steps/0/remove": ["hung"]}, "steps[1].remove[0]",
      ["'hung' is already removed by step 'static0' (steps[0])"]),
     ({"steps/1/name": "static0"}, "steps[1].name", ["duplicate step name 'static0'"]),
@@ -408,10 +408,11 @@ def test_slack_weightless_cable_has_no_shape():
     assert load_case(dump(loaded)).materials["strand"].weight == 0.0  # point mass on it
 
 
-def test_removing_a_distributed_load_is_refused():
+def test_removing_an_unnamed_distributed_load_is_refused():
+    # only a named distributed load can be added or removed (tests/test_loads.py)
     data = base(distributed_loads=[{"cable": "main", "load": [0.0, 1.0, 0.0]}],
                 **{"steps/1/remove": ["distributed0"]})
-    assert "is a distributed load" in problems(data)["steps[1].remove[0]"]
+    assert "unnamed distributed load" in problems(data)["steps[1].remove[0]"]
 
 
 def test_load_on_a_node_no_cable_reaches():

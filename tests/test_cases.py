@@ -172,3 +172,25 @@ def test_conductor_sag_then_temperature():
     assert float(hot.sag[0]) == pytest.approx(-z_mid, rel=1e-8)
     assert float(hot.horizontal_tension[0]) == pytest.approx(H, rel=1e-8)
     assert float(hot.sag[0]) > 7.5 + 0.1  # heating added sag the test can see
+# Snow on part of the span, a sudden gust, supports shaken by an acceleration record
+# ------------------------------------------------------------------------------------------------
+def test_snow_gust_ground_record():
+    case, tree = run_case("snow_gust_ground_record.toml")
+    st = tree["snowed"].to_dataset()
+    R = st.reaction.sel(node=["A", "B"]).values.sum(axis=0)
+    # the gust is absent (active = false); the snow covers 4.2 m <= s <= 9.6 m at 20 N/m
+    expected = np.array([0.0, 0.0, 5.0 * 9.81 * 15.0 + 20.0 * (9.6 - 4.2)])
+    np.testing.assert_allclose(R, expected, rtol=0, atol=1e-9 * float(st.tension.max()))
+    tr = tree["shaking"].to_dataset()
+    t = tr.time.values
+    # ground_record.csv samples the acceleration of u = 0.02 (1 - cos 2πt) every 0.01 s; both
+    # supports start from rest at their case positions and follow it within the bound of
+    # piecewise-linear acceleration, Δt² A ω² / 6 (docs/case-format.md)
+    u = 0.02 * (1.0 - np.cos(2.0 * math.pi * t))
+    bound = 0.01**2 * 0.02 * (2.0 * math.pi) ** 2 / 6.0
+    for node in ("A", "B"):
+        d = tr.displacement.sel(node=node).values
+        np.testing.assert_allclose(d[:, 0], u, rtol=0, atol=bound)
+        np.testing.assert_allclose(d[:, 1], 0.5 * u, rtol=0, atol=0.5 * bound)
+        np.testing.assert_allclose(d[:, 2], 0.0, atol=1e-15)
+        assert np.all(tr.velocity.sel(node=node).values[0] == 0.0)

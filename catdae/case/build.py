@@ -21,9 +21,10 @@ from pydantic import BaseModel, ValidationError
 
 from ..errors import CaseError
 from ..frame import gravity_rotation, local_axes
+from ..records import AccelerationRecord, VelocityRecord
 from ..timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
 from .limits import MIN_TIME, FileProblem, confined, read_limited, size_problems
-from .messages import _fmt_path, _found, _is_number, _message, _short, _unknown
+from .messages import _fmt_path, _found, _is_number, _message, _short, _suggest, _unknown
 from .model import (
     AXES,
     Cable,
@@ -408,9 +409,11 @@ class _Builder:
                 continue
             s = None if v.s is None else float(v.s)
             if section == "loads":
-                out.append(Load(v.name, tuple(float(f) for f in v.force), v.node, v.cable, s, time))
+                out.append(Load(v.name, tuple(float(f) for f in v.force), v.node, v.cable, s, time,
+                                active=v.active))
             else:
-                out.append(PointMass(v.name, float(v.mass), v.node, v.cable, s))
+                out.append(PointMass(v.name, float(v.mass), v.node, v.cable, s,
+                                     active=v.active))
         return out
 
     def location(self, v: Any, where: tuple, cables: dict) -> bool:
@@ -461,16 +464,46 @@ class _Builder:
                              _unknown(v.cable, "cable", sorted(self.cable_names)))
                 ok = False
             time = None if v.time is None else self.time_function(v.time, where + ("time",))
+            if not v.active and v.name is None:
+                self.problem(where + ("active",), "a distributed load with active = false "
+                             'needs a name (name = "...") so that a step can add it')
+                ok = False
             if not ok or v.cable not in cables or (v.time is not None and time is None):
                 continue
+            coverage = self.coverage(v, where, cables[v.cable][1])
+            if coverage is None:
+                continue
             out.append(DistributedLoad(v.name or f"distributed{i}", v.cable,
-                                       tuple(float(f) for f in v.load), time))
+                                       tuple(float(f) for f in v.load), time, *coverage,
+                                       active=v.active))
         return out
 
+    def coverage(self, v: Any, where: tuple, cable: Cable) -> tuple[float, float] | None:
+        """``(from_s, to_s)`` of a distributed load, within its cable and in order."""
+        length = cable.length
+        a = 0.0 if v.from_s is None else float(v.from_s)
+        b = length if v.to_s is None else float(v.to_s)
+        ok = True
+        for key, value in (("from_s", v.from_s), ("to_s", v.to_s)):
+            if value is not None and value > length:
+                self.problem(where + (key,), f"expected 0 <= {key} <= {length:g} (the length "
+                             f"of cable {cable.name!r}), found {value:g}")
+                ok = False
+        if ok and not a < b:
+            self.problem(where + ("to_s",), f"expected from_s < to_s (the load covers "
+                         f"from_s <= s <= to_s), found from_s = {a:g} and to_s = {b:g}")
+            ok = False
+        return (a, b) if ok else None
+
     def unique_names(self, top: _Top) -> None:
-        """Point masses, loads and distributed loads share one namespace."""
+        """Point masses, loads and distributed loads share one namespace.
+
+        ``removable``: the names a step may ``add`` or ``remove`` (distributed loads only
+        when named); ``inactive``: those absent at the start (``active = false``).
+        """
         self.removable: dict[str, str] = {}
         self.distributed_names: set[str] = set()
+        self.inactive: set[str] = set()
         seen: dict[str, str] = {}
         for section in ("point_masses", "loads", "distributed_loads"):
             for i, item in enumerate(getattr(top, section)):
@@ -485,10 +518,12 @@ class _Builder:
                                  f"{seen[nm]}); point masses and loads share one namespace")
                     continue
                 seen[nm] = here
-                if section == "distributed_loads":
+                if section == "distributed_loads" and "name" not in item:
                     self.distributed_names.add(nm)
                 else:
                     self.removable[nm] = here
+                if item.get("active") is False:
+                    self.inactive.add(nm)
 
     def support_motions(self, raw: list[dict], nodes: dict, supports: dict) -> list:
         out = []
@@ -525,7 +560,7 @@ class _Builder:
                                  f"fixed (fixed axes: {list(fixed)}); only a fixed axis can be "
                                  "moved")
                     ok = False
-                funcs[axis] = self.time_function(spec, where + (axis,))
+                funcs[axis] = self.time_function(spec, where + (axis,), motion=True)
                 ok = ok and funcs[axis] is not None
             if ok and fixed is not None:
                 out.append(SupportMotion(v.node, **funcs))
@@ -534,7 +569,9 @@ class _Builder:
     def steps(self, raw: list[dict]) -> list[Step]:
         out = []
         names: dict[str, int] = {}
-        removed: dict[str, str] = {}
+        # what is present before each step, and why: the name -> (present, reason) of add/remove
+        presence = {r: (r not in self.inactive, "active = false" if r in self.inactive else
+                        "active from the start") for r in self.removable}
         for i, item in enumerate(raw):
             where = ("steps", i)
             kind = item.get("kind")
@@ -567,18 +604,7 @@ class _Builder:
             names.setdefault(nm, i)
             if v is None:
                 continue
-            for j, r in enumerate(v.remove):
-                if r in removed:
-                    self.problem(where + ("remove", j), f"{r!r} is already removed by "
-                                 f"{removed[r]}")
-                elif r in self.removable:
-                    removed[r] = f"step {nm!r} ({_fmt_path(where)})"
-                elif r in self.distributed_names:
-                    self.problem(where + ("remove", j), f"{r!r} is a distributed load; only "
-                                 "point masses and loads can be removed")
-                else:
-                    self.problem(where + ("remove", j), _unknown(r, "point mass or load",
-                                                                 sorted(self.removable)))
+            self.add_remove(v, where, nm, presence)
             extra: dict[str, Any] = {}
             if kind == "static":
                 extra = {"load_steps": v.load_steps}
@@ -596,7 +622,8 @@ class _Builder:
             temperature = self.temperature(v.temperature_change, where)
             if complete and temperature is not False:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
-                                temperature_change=temperature, **extra))
+                                add=tuple(v.add), temperature_change=temperature,
+                                **extra))
         return out
 
     def temperature(self, raw: Any, where: tuple) -> float | FrozenMap | None | bool:
@@ -630,6 +657,35 @@ class _Builder:
                 f"cable {found[0]!r} has its length found by form-finding, which holds in the "
                 "first step: expected a static step first, found "
                 f"{_found(raw_steps[0].get('kind'))}"))
+
+    def add_remove(self, v: Any, where: tuple, step: str, presence: dict) -> None:
+        """A step's ``add`` names what is absent before it, its ``remove`` what is present."""
+        here = f"step {step!r} ({_fmt_path(where)})"
+        for key in ("add", "remove"):
+            for j, r in enumerate(getattr(v, key)):
+                at = where + (key, j)
+                if r not in self.removable:
+                    if r in self.distributed_names:
+                        self.problem(at, f"{r!r} is the default name of an unnamed distributed "
+                                     f'load; give it name = "..." to {key} it')
+                    else:
+                        self.problem(at, _unknown(r, "point mass, load or distributed load",
+                                                  sorted(self.removable)))
+                    continue
+                if key == "remove" and r in v.add:
+                    self.problem(at, f"{r!r} is both added and removed by this step")
+                    continue
+                present, why = presence[r]
+                if key == "add" and present:
+                    self.problem(at, f"{r!r} is already present ({why}); add names what is "
+                                 "absent (active = false, or removed by an earlier step)")
+                elif key == "remove" and not present:
+                    if why == "active = false":
+                        why = "absent: it has active = false and no earlier step adds it"
+                    self.problem(at, f"{r!r} is {why}")
+                else:
+                    presence[r] = (key == "add", f"added by {here}" if key == "add"
+                                   else f"already removed by {here}")
 
     def damping(self, raw: dict, step_where: tuple) -> Damping | None:
         where = step_where + ("damping",)
@@ -679,7 +735,10 @@ class _Builder:
             self.problem(where + ("kind",), f"expected a string, found {_found(kind)}")
         return None
 
-    def time_function(self, raw: dict, where: tuple) -> TimeFunction | None:
+    def time_function(self, raw: dict, where: tuple, motion: bool = False
+                      ) -> TimeFunction | None:
+        """A time function; ``motion``: it prescribes a support's displacement (a ``table``
+        may then be a velocity or acceleration record)."""
         kind = self.kind_of(raw, where, _TIME_MODELS, "time function kind")
         if kind is None:
             return None
@@ -694,7 +753,7 @@ class _Builder:
             cls = Sine if kind == "sine" else Cosine
             tf = cls(float(v.amplitude), float(v.frequency), float(v.phase), float(v.offset))
         else:
-            tf = self.table(v, where)
+            tf = self.table(v, where, motion)
         if tf is not None and not _finite(tf):
             self.problem(where, "its value, rate or second derivative overflows (not a "
                          "finite number): check the amplitude against the duration or "
@@ -702,7 +761,8 @@ class _Builder:
             return None
         return tf
 
-    def table(self, v: _TableTF, where: tuple) -> Table | None:
+    def table(self, v: _TableTF, where: tuple, motion: bool = False
+              ) -> Table | AccelerationRecord | VelocityRecord | None:
         inline = v.t is not None or v.value is not None
         if v.file is not None and inline:
             self.problem(where, "give either file, or t and value, not both")
@@ -711,8 +771,16 @@ class _Builder:
             self.problem(where, 'a table needs file = "points.csv" or inline t = [...] and '
                          "value = [...]")
             return None
+        if v.quantity != "displacement" and not motion:
+            self.problem(where + ("quantity",), f"quantity = {v.quantity!r} applies to support "
+                         "motions only; a load's time function is a factor that multiplies it")
+            return None
+        if v.column is not None and v.file is None:
+            self.problem(where + ("column",), "column selects a column of a table file; an "
+                         "inline table has one list of values")
+            return None
         if v.file is not None:
-            rows = self.read_csv(v.file, where + ("file",))
+            rows = self.read_csv(v.file, where + ("file",), v.column, where + ("column",))
             if rows is None:
                 return None
             t, value, at = [r[0] for r in rows], [r[1] for r in rows], where + ("file",)
@@ -737,13 +805,21 @@ class _Builder:
                              "apart, "
                              f"found {t[j - 1]:g} then {t[j]:g} (point {j})")
                 return None
-        return Table(tuple(float(x) for x in t), tuple(float(x) for x in value), v.file)
+        t, value = tuple(float(x) for x in t), tuple(float(x) for x in value)
+        if v.quantity == "acceleration":
+            return AccelerationRecord(t, value, v.file, v.column)
+        if v.quantity == "velocity":
+            return VelocityRecord(t, value, v.file, v.column)
+        return Table(t, value, v.file)
 
-    def read_csv(self, name: str, where: tuple) -> list[tuple[float, float]] | None:
+    def read_csv(self, name: str, where: tuple, column: str | None = None,
+                 column_where: tuple = ()) -> list[tuple[float, float]] | None:
         """Rows ``time, value`` of a CSV file; blank and ``#`` lines skipped, one header allowed.
 
-        The file must be a regular file inside the case's folder (or a folder listed in
-        CATDAE_TABLE_ROOTS) of at most MAX_FILE_BYTES; problems name the line, never quote it.
+        With ``column``, the file has a header naming its columns (time first) and the value
+        is taken from the column of that name. The file must be a regular file inside the case's
+        folder (or a folder listed in CATDAE_TABLE_ROOTS) of at most MAX_FILE_BYTES; problems
+        name the line, never quote a data row.
         """
         try:
             file = confined(name, self.base_dir)
@@ -757,26 +833,45 @@ class _Builder:
             self.problem(where, f"cannot read table file {_short(name)}: not UTF-8 text "
                          f"(byte {exc.start})")
             return None
-        rows = []
-        for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
-            cells = [c.strip() for c in row]
-            if not any(cells) or cells[0].startswith("#"):
-                continue
-            try:
-                pair = (float(cells[0]), float(cells[1])) if len(cells) == 2 else None
-            except ValueError:
-                pair = None
-            if pair is None:
-                if not rows and lineno == 1:
-                    continue  # a header line such as "time,value"
-                found = (f"{len(cells)} field(s)" if len(cells) != 2
-                         else "a field that is not a number")
-                self.problem(where, f"{_short(name)}, line {lineno}: expected two "
-                             f"numbers 'time,value', found {found}")
+        lines = [(n, [c.strip() for c in row])
+                 for n, row in enumerate(csv.reader(text.splitlines()), start=1)]
+        lines = [(n, c) for n, c in lines if any(c) and not c[0].startswith("#")]
+        header: list[str] | None = None
+        if lines and not all(_is_float(c) for c in lines[0][1]):
+            header = lines[0][1]  # a header line such as "time,value" or "t,ax,ay,az"
+            lines = lines[1:]
+        width = len(header) if header is not None else len(lines[0][1]) if lines else 2
+        if column is None and width != 2:
+            names = f" ({', '.join(header)})" if header is not None else ""
+            self.problem(where, f"{name} has {width} columns{names}: choose the value column "
+                         'with column = "<name>" (time is the first column)')
+            return None
+        index = 1
+        if column is not None:
+            if header is None:
+                self.problem(column_where, f"column = {column!r} needs a header line in {name} "
+                             "naming its columns, time first (e.g. t,ax,ay,az); found none")
                 return None
-            if not all(math.isfinite(x) for x in pair):
-                self.problem(where, f"{_short(name)}, line {lineno}: expected finite "
-                             "numbers, found inf or nan")
+            if column not in header[1:]:
+                hint = (f"{column!r} is the time column" if column == header[0] else
+                        f"{name} has no column {column!r}{_suggest(column, header[1:])} (its "
+                        f"columns: {', '.join(header)}; time is the first)")
+                self.problem(column_where, hint)
+                return None
+            index = header.index(column)
+        expect = "two numbers 'time,value'" if width == 2 else f"{width} numbers per row"
+        rows = []
+        for lineno, cells in lines:
+            if len(cells) != width or not all(_is_float(c) for c in cells):
+                found = (f"{len(cells)} field(s)" if len(cells) != width
+                         else "a field that is not a number")
+                self.problem(where, f"{_short(name)}, line {lineno}: expected {expect}, found "
+                             f"{found}")
+                return None
+            pair = (float(cells[0]), float(cells[index]))
+            if not all(math.isfinite(float(c)) for c in cells):
+                self.problem(where, f"{_short(name)}, line {lineno}: expected finite numbers, "
+                             "found inf or nan")
                 return None
             rows.append(pair)
         return rows
@@ -845,3 +940,12 @@ def _finite(tf: TimeFunction) -> bool:
     with np.errstate(all="ignore"):
         values = tf.evaluate(np.asarray(ts, float))
     return all(np.isfinite(v).all() for v in values)
+
+
+def _is_float(cell: str) -> bool:
+    """Whether a CSV cell reads as a number (inf and nan included: reported as not finite)."""
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True

@@ -108,20 +108,25 @@ class Cable:
 
 @dataclass(frozen=True)
 class PointMass:
-    """A concentrated mass in kg, at ``node`` or on ``cable`` at unstrained arc length ``s`` (m)."""
+    """A concentrated mass in kg, at ``node`` or on ``cable`` at unstrained arc length ``s`` (m).
+
+    ``active = False``: absent until a step adds it.
+    """
 
     name: str
     mass: float
     node: str | None = None
     cable: str | None = None
     s: float | None = None
+    active: bool = True
 
 
 @dataclass(frozen=True)
 class Load:
     """A concentrated force (N, global x, y, z) at ``node`` or on ``cable`` at ``s``.
 
-    ``time`` multiplies the force; ``None`` means a constant load (factor 1).
+    ``time`` multiplies the force; ``None`` means a constant load (factor 1). ``active =
+    False``: absent until a step adds it.
     """
 
     name: str
@@ -130,16 +135,23 @@ class Load:
     cable: str | None = None
     s: float | None = None
     time: TimeFunction | None = None
+    active: bool = True
 
 
 @dataclass(frozen=True)
 class DistributedLoad:
-    """A force per metre of unstrained cable (N/m, global axes) on the whole of ``cable``."""
+    """A force per metre of unstrained cable (N/m, global axes) on ``from_s <= s <= to_s`` of
+    ``cable`` (unstrained arc length, m; by default the whole cable). ``time`` multiplies the
+    load; ``active = False``: absent until a step adds it.
+    """
 
     name: str
     cable: str
     load: tuple[float, float, float]
     time: TimeFunction | None = None
+    from_s: float = 0.0
+    to_s: float = math.inf
+    active: bool = True
 
 
 @dataclass(frozen=True)
@@ -191,8 +203,9 @@ class Damping:
 class Step:
     """One analysis step. Fields that do not apply to ``kind`` keep their defaults.
 
-    ``remove`` names point masses or loads taken away from this step on. ``temperature_change``
-    (K) from the reference temperature, from this step on: a number for every cable, a mapping
+    ``add`` names point masses or loads (``active = false``, or removed before) present from
+    this step on; ``remove`` those taken away from this step on. ``temperature_change`` (K)
+    from the reference temperature, from this step on: a number for every cable, a mapping
     cable name -> K (cables not named: 0), or ``None`` to keep that of the previous step (0 at
     the start). Static: ``load_steps``.
     Modal: ``modes``, ``mass_model``. Transient: ``duration`` and ``output_interval`` (s),
@@ -205,6 +218,7 @@ class Step:
     kind: Literal["static", "modal", "transient"]
     name: str
     remove: tuple[str, ...] = ()
+    add: tuple[str, ...] = ()
     modes: int = 10
     duration: float | None = None
     output_interval: float | None = None

@@ -67,6 +67,7 @@ class _PointMass(BaseModel):
     node: Name | None = None
     cable: Name | None = None
     s: NonNeg | None = None
+    active: bool = True
 
 
 class _Load(BaseModel):
@@ -77,6 +78,7 @@ class _Load(BaseModel):
     cable: Name | None = None
     s: NonNeg | None = None
     time: TomlTable | None = None
+    active: bool = True
 
 
 class _DistributedLoad(BaseModel):
@@ -85,6 +87,9 @@ class _DistributedLoad(BaseModel):
     cable: Name
     load: Vec3
     time: TomlTable | None = None
+    from_s: NonNeg | None = None  # m, unstrained arc length; default 0
+    to_s: Pos | None = None  # m; default the cable's length
+    active: bool = True
 
 
 class _SupportMotion(BaseModel):
@@ -101,6 +106,7 @@ class _StaticStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    add: list[Name] = []
     load_steps: Annotated[int, Field(ge=1)] = 1
 
 
@@ -110,6 +116,7 @@ class _ModalStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
 
@@ -120,6 +127,7 @@ class _TransientStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    add: list[Name] = []
     duration: Time
     output_interval: Time
     rtol: Pos = 1e-6
@@ -198,6 +206,8 @@ class _TableTF(BaseModel):
     file: Name | None = None
     t: list[float] | None = None
     value: list[float] | None = None
+    column: Name | None = None  # a named column of a CSV file with several
+    quantity: Literal["displacement", "velocity", "acceleration"] = "displacement"
 
 
 _TIME_MODELS: dict[str, type[BaseModel]] = {
