@@ -114,15 +114,10 @@ class TransientProblem:
             self.alpha, self.beta = self.damping.coefficients()
         self.material = self.damping is not None and self.damping.kind == "material"
         self.lagrangian = step.inertia == "lagrangian" and (
-            model.mass_model == "consistent")
+            model.mass_model in ("consistent", "blended"))
         nd = model.n_dof
-        if model.mass_model == "lumped":
-            self.m_diag = model.lumped_mass_diag()
-            self.c_diag = (model.lumped_mass_diag(model.mesh.c) if self.material
-                           else np.zeros(nd))
-        else:
-            self.m_diag = np.repeat(model.loading.node_mass, 3)
-            self.c_diag = np.zeros(nd)
+        self.m_diag = model.diagonal_mass()
+        self.c_diag = model.diagonal_mass(model.mesh.c) if self.material else np.zeros(nd)
         # --- work arrays and state
         self._wl0 = model.mesh.w * model.mesh.L0
         self._dummy3 = np.zeros((1, 6, 6))
@@ -161,14 +156,13 @@ class TransientProblem:
         self.X[self.fidx] = q
         self.X[m.fixed] = xp
         m.set_time(t)
-        out = m.dynamic_state(self.X.reshape(-1, 3), self.h, self.material)
+        out = m.dynamic_state(self.X.reshape(-1, 3), self.h, self.material,
+                              gradient=self.lagrangian)
         state = out[0]
         if (state.status == NOT_CONVERGED).any() or not np.all(np.isfinite(state.h)):
             out = None
         else:
             self.h = state.h
-            dm = m.elements.mass_gradient(state) if self.lagrangian else None
-            out = (*out, dm)
         self._cache_t, self._cache_q, self._cache = t, np.array(q, copy=True), out
         return out
 
@@ -483,7 +477,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "atol_velocity": step.atol * omega, "status": status, "linear_solver": linsolver,
             "bandwidth": prob.bandwidth, "max_order": int(step.max_order),
             "mass_model": model.mass_model, "inertia": step.inertia if prob.lagrangian else
-            "paper" if model.mass_model == "consistent" else "constant mass",
+            "paper" if model.mass_model in ("consistent", "blended") else "constant mass",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
             "n_outputs": n_valid, "n_restarts": n_restarts, "note": _note(model, prob),
@@ -578,7 +572,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
 def _note(model: Model, prob: TransientProblem) -> str:
     """Advice on the result's accuracy that the run itself found ("" when none)."""
     jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
-    if model.mass_model != "consistent" or not jumps:
+    if model.mass_model not in ("consistent", "blended") or not jumps:
         return ""
     t, dv, lam2 = jumps[0]
     return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "

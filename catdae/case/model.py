@@ -17,6 +17,7 @@ from ..timefunc import TimeFunction
 from .messages import _found, _is_number
 
 AXES = ("x", "y", "z")
+MASS_MODELS = ("blended", "consistent", "lumped", "linear")  # docs/case-format.md, mass_model
 
 
 class FrozenMap(Mapping):
@@ -189,7 +190,7 @@ class Step:
     damping: Damping | None = None
     max_order: int = 5
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
@@ -258,9 +259,9 @@ class Case:
             and elements >= 1
         ):
             problems.append(("elements", f"expected an integer >= 1, found {_found(elements)}"))
-        if mass_model is not None and mass_model not in ("consistent", "lumped", "linear"):
-            problems.append(("mass_model", 'expected "consistent", "lumped" or "linear", '
-                             f"found {_found(mass_model)}"))
+        if mass_model is not None and mass_model not in MASS_MODELS:
+            problems.append(("mass_model", 'expected "blended", "consistent", "lumped" or '
+                             f'"linear", found {_found(mass_model)}'))
         if problems:
             raise CaseError(self.path, problems)
         steps = tuple(

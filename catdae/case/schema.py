@@ -103,7 +103,7 @@ class _ModalStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
-    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
 
 
 class _TransientStep(BaseModel):
@@ -118,7 +118,7 @@ class _TransientStep(BaseModel):
     damping: TomlTable | None = None
     max_order: Annotated[int, Field(ge=1, le=5)] = 5
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 
