@@ -97,6 +97,11 @@ def _run(args) -> int:
     if not out.parent.is_dir():
         print(f"catdae: cannot write {out}: no directory {out.parent}", file=sys.stderr)
         return 2
+    from .element import kernels_cached
+
+    if not kernels_cached():
+        print("catdae: compiling the element kernels for this machine (once after install or "
+              "upgrade, about a minute)...", file=sys.stderr, flush=True)
     try:
         tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
                    elements=args.elements, mass_model=args.mass_model)

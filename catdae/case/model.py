@@ -188,7 +188,7 @@ class Step:
     rtol: float = 1e-6
     atol: float = 1e-8
     damping: Damping | None = None
-    max_order: int = 5
+    max_order: int | Literal["auto"] = "auto"
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
     load_steps: int = 1
