@@ -73,17 +73,19 @@ def worker() -> None:
     for k, (x, y, z) in enumerate(X):
         ops.node(k + 1, x, y, z)
     a, b = job["supports"]
-    ops.fix(a + 1, 1, 1, 0)  # z of A is imposed below
-    ops.fix(b + 1, 1, 1, 1)
+    # the moving support and axis (default: z of A) and the amplitude of a (1 - cos πt)
+    moving, axis, amp = job.get("motion", (a, 3, 0.5))
+    for node in (a, b):
+        ops.fix(node + 1, *[0 if (node == moving and d == axis) else 1 for d in (1, 2, 3)])
     for e, (i, j) in enumerate(conn):
         ops.element("CatenaryCable", e + 1, i + 1, j + 1, job["weight"], job["EA"], 1.0,
                     job["L0e"][e], 0.0, 0.0, job["rho"], job["error_tol"], job.get("nsub", 1), 0)
     # support motion: z_A(t) = 0.5 (1 - cos πt), sampled exactly at the steps
     nsteps = int(round(duration / dt))
-    values = [0.5 * (1.0 - math.cos(math.pi * k * dt)) for k in range(nsteps + 2)]
+    values = [amp * (1.0 - math.cos(math.pi * k * dt)) for k in range(nsteps + 2)]
     ops.timeSeries("Path", 1, "-dt", dt, "-values", *values)
     ops.pattern("Plain", 1, 1)
-    ops.sp(a + 1, 3, 1.0)
+    ops.sp(moving + 1, axis, 1.0)
     # static check (support motion at its t = 0 value, zero): the catenary positions must
     # already be in equilibrium
     ops.constraints("Transformation")

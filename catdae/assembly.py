@@ -20,6 +20,11 @@ from .element import Elements, ElementState, PointLoads
 from .mesh import AXES, Mesh
 from .timefunc import TimeFunction
 
+# lumped fraction μ of mass_model = "blended": M = (1 - μ) M_consistent + μ M_lumped. μ = 1/2
+# cancels the leading (second-order) frequency error of the two, which have opposite signs
+# (docs/theory.md §7; measured in tests/test_modal.py and benchmarks/speed_accuracy.md)
+BLEND_LUMPED = 0.5
+
 
 class Pattern:
     """CSR sparsity of element 6x6 blocks plus the diagonal, with a scatter map.
@@ -178,6 +183,8 @@ class Model:
         self.mesh = mesh
         self.loading = build_loading(case, mesh, absent)
         self.mass_model = mass_model
+        # the blend's lumped fraction μ: M = (1 - μ) M_consistent + μ M_lumped
+        self.lumped_fraction = {"blended": BLEND_LUMPED, "lumped": 1.0}.get(mass_model, 0.0)
         nn = mesh.n_nodes
         self.n_dof = 3 * nn
         fixed = np.zeros((nn, 3), bool)
@@ -315,8 +322,23 @@ class Model:
         if self.mass_model == "linear":
             return self.linear_element_mass()
         ld = self.loading
-        return self.elements.element_masses(state, self.gauss_s, self.gauss_w, self.mesh.m,
-                                            (ld.mass_elem, ld.mass_s, ld.mass_value))
+        me = self.elements.element_masses(state, self.gauss_s, self.gauss_w, self.mesh.m,
+                                          (ld.mass_elem, ld.mass_s, ld.mass_value))
+        if self.mass_model == "blended":
+            me *= 1.0 - self.lumped_fraction
+        return me
+
+    def diagonal_mass(self, per_length: np.ndarray | None = None) -> np.ndarray:
+        """The diagonal part of the mass matrix (of damping with ``per_length``), (n_dof,):
+        nodal masses, plus μ times the lumped element masses (μ = 1 lumped, 1/2 blended, 0
+        consistent and linear)."""
+        mu = self.lumped_fraction
+        node = (np.zeros(self.n_dof) if per_length is not None
+                else np.repeat(self.loading.node_mass, 3))
+        if mu == 0.0:
+            return node
+        return node + mu * (self.lumped_mass_diag(per_length) - (
+            node if per_length is None else 0.0))
 
     def linear_element_mass(self, damping: bool = False) -> np.ndarray:
         """Element matrices of straight-line interpolation N = [(1-ξ) I, ξ I], (n_elem, 6, 6).
@@ -344,24 +366,37 @@ class Model:
         cache[damping] = out
         return out
 
-    def dynamic_state(self, X: np.ndarray, h0: np.ndarray | None, material_damping: bool):
+    def dynamic_state(self, X: np.ndarray, h0: np.ndarray | None, material_damping: bool,
+                      gradient: bool = False):
         """Element state with element mass (and material damping) matrices in one pass.
 
-        Returns (state, M_e (n_elem, 6, 6) or None when the mass is lumped, C_e or None).
+        Returns (state, M_e (n_elem, 6, 6) or None when the mass is lumped, C_e or None,
+        ∂M_e/∂c_k (n_elem, 3, 6, 6) or None): the gradient (analytic, of the consistent part)
+        with ``gradient`` and a consistent or blended mass only.
         """
         mesh = self.mesh
         ld = self.loading
         if self.mass_model == "linear":
             state = self.elements.solve(self.chords(X), h0)
             ce = self.linear_element_mass(damping=True) if material_damping else None
-            return state, self.linear_element_mass(), ce
-        state, me, ce = self.elements.solve_dynamic(
+            return state, self.linear_element_mass(), ce, None
+        gradient = gradient and self.mass_model in ("consistent", "blended")
+        out = self.elements.solve_dynamic(
             self.chords(X), h0, self.gauss_s, self.gauss_w, mesh.m,
-            mesh.c if material_damping and self.mass_model == "consistent" else None,
-            (ld.mass_elem, ld.mass_s, ld.mass_value))
+            mesh.c if material_damping and self.mass_model in ("consistent", "blended")
+            else None, (ld.mass_elem, ld.mass_s, ld.mass_value), gradient=gradient)
+        state, me, ce = out[:3]
+        dm = out[3] if gradient else None
         if self.mass_model == "lumped":
             me = None
-        return state, me, ce
+        elif self.mass_model == "blended":
+            keep = 1.0 - self.lumped_fraction
+            me *= keep
+            if ce is not None:
+                ce *= keep
+            if dm is not None:
+                dm *= keep
+        return state, me, ce, dm
 
     def lumped_mass_diag(self, per_length: np.ndarray | None = None) -> np.ndarray:
         """Lumped diagonal on the dofs: half of each element at each end, (n_dof,).
@@ -384,10 +419,9 @@ class Model:
 
     def mass_data(self, state: ElementState) -> np.ndarray:
         """CSR data of the mass matrix M(q) on the full dof set."""
-        node_diag = np.repeat(self.loading.node_mass, 3)
         if self.mass_model == "lumped":
             return self.pattern.assemble(None, self.lumped_mass_diag())
-        return self.pattern.assemble(self.element_mass(state), node_diag)
+        return self.pattern.assemble(self.element_mass(state), self.diagonal_mass())
 
     def mass(self, state: ElementState) -> sp.csr_matrix:
         return self.pattern.matrix(self.mass_data(state))

@@ -41,7 +41,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--rtol", type=float, help="relative tolerance of transient steps")
     r.add_argument("--atol", type=float, help="absolute tolerance of transient steps, m")
     r.add_argument("--elements", type=int, help="elements per cable")
-    r.add_argument("--mass-model", choices=("consistent", "lumped", "linear"),
+    r.add_argument("--mass-model", choices=("blended", "consistent", "lumped", "linear"),
                    help="mass model of every transient and modal step")
     r.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: on a terminal)")
@@ -148,6 +148,11 @@ def _run(args) -> int:
     except OutputError as exc:  # judged before any work: a usage error
         print(f"catdae: {exc}", file=sys.stderr)
         return 2
+    from .element import kernels_cached
+
+    if not kernels_cached():
+        print("catdae: compiling the element kernels for this machine (once after install or "
+              "upgrade, about a minute)...", file=sys.stderr, flush=True)
     try:
         tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
                    elements=args.elements, mass_model=args.mass_model)

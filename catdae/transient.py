@@ -114,15 +114,10 @@ class TransientProblem:
             self.alpha, self.beta = self.damping.coefficients()
         self.material = self.damping is not None and self.damping.kind == "material"
         self.lagrangian = step.inertia == "lagrangian" and (
-            model.mass_model == "consistent")
+            model.mass_model in ("consistent", "blended"))
         nd = model.n_dof
-        if model.mass_model == "lumped":
-            self.m_diag = model.lumped_mass_diag()
-            self.c_diag = (model.lumped_mass_diag(model.mesh.c) if self.material
-                           else np.zeros(nd))
-        else:
-            self.m_diag = np.repeat(model.loading.node_mass, 3)
-            self.c_diag = np.zeros(nd)
+        self.m_diag = model.diagonal_mass()
+        self.c_diag = model.diagonal_mass(model.mesh.c) if self.material else np.zeros(nd)
         # --- work arrays and state
         self._wl0 = model.mesh.w * model.mesh.L0
         self._dummy3 = np.zeros((1, 6, 6))
@@ -161,14 +156,13 @@ class TransientProblem:
         self.X[self.fidx] = q
         self.X[m.fixed] = xp
         m.set_time(t)
-        out = m.dynamic_state(self.X.reshape(-1, 3), self.h, self.material)
+        out = m.dynamic_state(self.X.reshape(-1, 3), self.h, self.material,
+                              gradient=self.lagrangian)
         state = out[0]
         if (state.status == NOT_CONVERGED).any() or not np.all(np.isfinite(state.h)):
             out = None
         else:
             self.h = state.h
-            dm = m.elements.mass_gradient(state) if self.lagrangian else None
-            out = (*out, dm)
         self._cache_t, self._cache_q, self._cache = t, np.array(q, copy=True), out
         return out
 
@@ -429,7 +423,9 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     atol = np.empty(2 * prob.n)
     atol[0::2] = step.atol
     atol[1::2] = step.atol * omega
-    options = dict(rtol=step.rtol, atol=atol, max_order=int(step.max_order),
+    auto = step.max_order == "auto"
+    order_choice = OrderChoice(_highest_frequency(prob, t0, y0)) if auto else None
+    options = dict(rtol=step.rtol, atol=atol, max_order=5 if auto else int(step.max_order),
                    max_num_steps=100000, linsolver=linsolver)
     if linsolver == "band":
         bw = prob.bandwidth
@@ -438,12 +434,15 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
         options.update(sparsity=prob.j_pattern, jacfn=prob.jac_sparse)
     else:
         options.update(jacfn=prob.jac_dense)
-    with warnings.catch_warnings():
-        # sksundae warns that its own sparse approximation is unused when jacfn is given:
-        # that is the intent (the analytic iteration matrix)
-        warnings.filterwarnings("ignore", "Custom sparse Jacobian approximation",
-                                UserWarning)
-        solver = IDA(prob.resfn, **options)
+    def make_solver(max_order):
+        with warnings.catch_warnings():
+            # sksundae warns that its own sparse approximation is unused when jacfn is given:
+            # that is the intent (the analytic iteration matrix)
+            warnings.filterwarnings("ignore", "Custom sparse Jacobian approximation",
+                                    UserWarning)
+            return IDA(prob.resfn, **dict(options, max_order=max_order))
+
+    solver = make_solver(options["max_order"])
     solver.init_step(t0, y0, yp0)
 
     nn = model.mesh.n_nodes
@@ -482,9 +481,12 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "n_rejected_states": prob.n_rejected,
             "wall_time": _time.perf_counter() - wall0, "rtol": step.rtol, "atol": step.atol,
             "atol_velocity": step.atol * omega, "status": status, "linear_solver": linsolver,
-            "bandwidth": prob.bandwidth, "max_order": int(step.max_order),
+            "bandwidth": prob.bandwidth,
+            "max_order": (order_choice.order if auto else int(step.max_order)),
+            "max_order_setting": str(step.max_order),
+            "order_choice": order_choice.summary() if auto else "fixed by the step",
             "mass_model": model.mass_model, "inertia": step.inertia if prob.lagrangian else
-            "paper" if model.mass_model == "consistent" else "constant mass",
+            "paper" if model.mass_model in ("consistent", "blended") else "constant mass",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
             "n_outputs": n_valid, "n_restarts": n_restarts, "note": _note(model, prob),
@@ -549,6 +551,11 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
                        and abs(times[k_done] - t_int) <= 1e-13 * max(abs(t_int), 1.0)):
                     record(k_done, times[k_done], y_last, yp_last)
                     k_done += 1
+            elif order_choice is not None and not order_choice.decided:
+                new_order = order_choice.observe(t_int)
+                if new_order is not None:
+                    solver = make_solver(new_order)
+                    solver.init_step(t_int, y_last, yp_last)
             bar.update(t_int)
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(step.name, dataset(k_done))
@@ -581,7 +588,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
 def _note(model: Model, prob: TransientProblem) -> str:
     """Advice on the result's accuracy that the run itself found ("" when none)."""
     jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
-    if model.mass_model != "consistent" or not jumps:
+    if model.mass_model not in ("consistent", "blended") or not jumps:
         return ""
     t, dv, lam2 = jumps[0]
     return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "
@@ -589,6 +596,95 @@ def _note(model: Model, prob: TransientProblem) -> str:
             f"elements that take a chord change by sag (element λ² up to {lam2:.3g} here, "
             "> 1); tensions may be underestimated (try mass_model = \"lumped\" or \"linear\", "
             "or more elements; README, Accuracy and known limits)")
+
+
+class OrderChoice:
+    """The BDF order cap of ``max_order = "auto"``, chosen by measurement during the run.
+
+    BDF orders 3-5 are not stable along the imaginary axis: undamped modes with h ω of order 1
+    (the axial modes of a fine mesh) force their step down, whatever the accuracy needs. BDF2
+    is A-stable (and damps modes far above 1/h) but at the same rtol its errors are about ten
+    times larger (benchmarks/speed_accuracy.md), so it must take several times fewer steps to
+    win at equal error. The run starts at order 5; after a start-up window of ``WINDOW``
+    steps, if the steps are short against the highest natural frequency (h ω_max <
+    ``STABILITY_HW``: stability-bound), the next window runs at order 2, and order 2 is kept
+    if it advances more than ``GAIN`` times faster per step, else order 5 is restored. The
+    decision is made once per step; ``order_choice`` in the results says what was measured.
+    """
+
+    WINDOW = 150
+    STABILITY_HW = 2.5
+    GAIN = 3.0
+
+    def __init__(self, omega_max: float | None):
+        self.omega_max = omega_max
+        self.order = 5
+        self.decided = omega_max is None
+        self.phase = "start-up"
+        self.count = 0
+        self.t_mark = None
+        self.rate5 = self.rate2 = None
+        self.note = "" if omega_max is not None else "no highest frequency: order 5 kept"
+
+    def observe(self, t: float) -> int | None:
+        """Called after every step at time t; returns a new order cap when it changes."""
+        self.count += 1
+        if self.t_mark is None:
+            self.t_mark = t
+        if self.count < self.WINDOW:
+            return None
+        dt = (t - self.t_mark) / self.count  # mean step of the window, s
+        self.count = 0
+        self.t_mark = t
+        if self.phase in ("start-up", "order 2 start-up"):
+            # a new IDA starts at order 1 with short steps: not measured
+            self.phase = "order 5" if self.phase == "start-up" else "order 2"
+            return None
+        if self.phase == "order 5":
+            self.rate5 = dt
+            if dt * self.omega_max >= self.STABILITY_HW:
+                self.decided = True
+                self.note = (f"order 5: accuracy-bound steps (h ω_max = "
+                             f"{dt * self.omega_max:.3g})")
+                return None
+            self.phase = "order 2 start-up"
+            self.order = 2
+            return 2
+        self.rate2 = dt
+        self.decided = True
+        if dt > self.GAIN * self.rate5:
+            self.note = (f"order 2: order 5 was stability-bound (h ω_max = "
+                         f"{self.rate5 * self.omega_max:.3g}), order 2 took {dt / self.rate5:.3g}"
+                         " times longer steps")
+            return None
+        self.order = 5
+        self.note = (f"order 5: stability-bound (h ω_max = {self.rate5 * self.omega_max:.3g}) "
+                     f"but order 2 took only {dt / self.rate5:.3g} times longer steps")
+        return 5
+
+    def summary(self) -> str:
+        return self.note or f"order {self.order} ({self.phase}: too few steps to measure)"
+
+
+def _highest_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float | None:
+    """ω_max of the free dofs about the start (rad/s), to 1 %, or None if it cannot be had."""
+    conf = prob.configuration(t0, y0[0::2])
+    if conf is None:
+        return None
+    try:
+        mff = prob.ff(prob.mass_data(conf))
+        kff = prob.ff(prob.model.pattern.assemble(conf[0].stiffness6))
+        if prob.n <= 400:
+            lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,
+                           subset_by_index=[prob.n - 1, prob.n - 1])[0]
+        else:
+            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), which="LA", tol=1e-2,
+                             v0=np.linspace(1.0, 2.0, prob.n), return_eigenvectors=False)[0]
+        if np.isfinite(lam) and lam > 0:
+            return float(np.sqrt(lam))
+    except (ValueError, RuntimeError, np.linalg.LinAlgError, spla.ArpackError):
+        pass
+    return None
 
 
 def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:
@@ -601,7 +697,10 @@ def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> f
             lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,
                            subset_by_index=[0, 0])[0]
         else:
-            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), sigma=0.0, which="LM",
+            # a fixed start vector: ARPACK's default is random, which made identical runs
+            # differ in their velocity atol (last digits) and so in their step counts
+            v0 = np.linspace(1.0, 2.0, prob.n)
+            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), sigma=0.0, which="LM", v0=v0,
                              return_eigenvectors=False)[0]
         if np.isfinite(lam) and lam > 0:
             return float(np.sqrt(lam))

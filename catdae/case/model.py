@@ -18,6 +18,7 @@ from .limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from .messages import _found, _is_number
 
 AXES = ("x", "y", "z")
+MASS_MODELS = ("blended", "consistent", "lumped", "linear")  # docs/case-format.md, mass_model
 
 
 class FrozenMap(Mapping):
@@ -225,9 +226,9 @@ class Step:
     rtol: float = 1e-6
     atol: float = 1e-8
     damping: Damping | None = None
-    max_order: int = 5
+    max_order: int | Literal["auto"] = "auto"
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
@@ -304,9 +305,9 @@ class Case:
         ):
             problems.append(("elements", f"expected an integer >= 1 and <= "
                              f"{MAX_ELEMENTS_PER_CABLE}, found {_found(elements)}"))
-        if mass_model is not None and mass_model not in ("consistent", "lumped", "linear"):
-            problems.append(("mass_model", 'expected "consistent", "lumped" or "linear", '
-                             f"found {_found(mass_model)}"))
+        if mass_model is not None and mass_model not in MASS_MODELS:
+            problems.append(("mass_model", 'expected "blended", "consistent", "lumped" or '
+                             f'"linear", found {_found(mass_model)}'))
         if problems:
             raise CaseError(self.path, problems)
         steps = tuple(

@@ -118,7 +118,7 @@ class _ModalStep(BaseModel):
     temperature_change: Any = None
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
-    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
 
 
 class _TransientStep(BaseModel):
@@ -133,9 +133,9 @@ class _TransientStep(BaseModel):
     rtol: Pos = 1e-6
     atol: Pos = 1e-8
     damping: TomlTable | None = None
-    max_order: Annotated[int, Field(ge=1, le=5)] = 5
+    max_order: Annotated[int, Field(ge=1, le=5)] | Literal["auto"] = "auto"
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 

@@ -30,7 +30,7 @@ _COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "linear_solver": ("", "linear solver requested"),
     "max_order": ("1", "largest BDF order of IDA"),
 }
-_CHOICES = {"mass_model": ("consistent", "lumped", "linear"),
+_CHOICES = {"mass_model": ("blended", "consistent", "lumped", "linear"),
             "linear_solver": ("auto", "band", "sparse", "dense")}
 _COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
 _MEMORY_NAMES = {
