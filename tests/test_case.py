@@ -160,7 +160,8 @@ def test_format_example_values():
     release = case.steps[2]
     assert release.remove == ("hung",) and case.steps[1].modes == 10
     assert (release.duration, release.output_interval, release.rtol, release.atol) == (
-        4.0, 0.01, 1e-6, 1e-8)
+        4.0, 0.01, 1e-4, 1e-6)
+    assert release.mass_model == "blended" and case.steps[1].mass_model == "consistent"
     assert release.damping == Damping("rayleigh", ratio=0.00155, frequencies=(1.5, 14.0))
 
 
