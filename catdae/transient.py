@@ -426,7 +426,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     atol[0::2] = step.atol
     atol[1::2] = step.atol * omega
     auto = step.max_order == "auto"
-    order_choice = OrderChoice(_highest_frequency(prob, t0, y0)) if auto else None
+    order_choice = OrderChoice(_highest_frequency(prob, t0, y0), omega) if auto else None
     options = dict(rtol=step.rtol, atol=atol, max_order=5 if auto else int(step.max_order),
                    max_num_steps=100000, linsolver=linsolver)
     if linsolver == "band":
@@ -604,65 +604,54 @@ class OrderChoice:
     """The BDF order cap of ``max_order = "auto"``, chosen by measurement during the run.
 
     BDF orders 3-5 are not stable along the imaginary axis: undamped modes with h ω of order 1
-    (the axial modes of a fine mesh) force their step down, whatever the accuracy needs. BDF2
-    is A-stable (and damps modes far above 1/h) but at the same rtol its errors are about ten
-    times larger (benchmarks/speed_accuracy.md), so it must take several times fewer steps to
-    win at equal error. The run starts at order 5; after a start-up window of ``WINDOW``
-    steps, if the steps are short against the highest natural frequency (h ω_max <
-    ``STABILITY_HW``: stability-bound), the next window runs at order 2, and order 2 is kept
-    if it advances more than ``GAIN`` times faster per step, else order 5 is restored. The
-    decision is made once per step; ``order_choice`` in the results says what was measured.
+    (the axial modes of a fine mesh) force their step down, whatever the accuracy needs, and the
+    steps per simulated second then grow with the mesh. BDF2 is A-stable (it damps the modes
+    far above 1/h). The run starts at order 5; after IDA's start-up window of ``WINDOW`` steps
+    the mean step h of the next window decides: order 5 is stability-bound where h ω_max <
+    ``STABILITY_HW``, and it is following the mesh's fast modes rather than the motion where it
+    also takes more than ``STEPS_PER_PERIOD`` steps per period of the lowest mode (2π/ω₁). Then
+    the rest of the step runs at order 2; otherwise order 5 stays (docs/theory.md §8.6;
+    measurements in benchmarks/speed_accuracy.md). ``order_choice`` says what was measured.
     """
 
     WINDOW = 150
     STABILITY_HW = 2.5
-    GAIN = 3.0
+    STEPS_PER_PERIOD = 1.0e4
 
-    def __init__(self, omega_max: float | None):
+    def __init__(self, omega_max: float | None, omega_1: float):
         self.omega_max = omega_max
+        self.omega_1 = omega_1
         self.order = 5
         self.decided = omega_max is None
         self.phase = "start-up"
         self.count = 0
         self.t_mark = None
-        self.rate5 = self.rate2 = None
         self.note = "" if omega_max is not None else "no highest frequency: order 5 kept"
 
     def observe(self, t: float) -> int | None:
-        """Called after every step at time t; returns a new order cap when it changes."""
+        """Called after every step at time t; returns the new order cap when it changes."""
         self.count += 1
         if self.t_mark is None:
             self.t_mark = t
         if self.count < self.WINDOW:
             return None
-        dt = (t - self.t_mark) / self.count  # mean step of the window, s
+        h = (t - self.t_mark) / self.count  # mean step of the window, s
         self.count = 0
         self.t_mark = t
-        if self.phase in ("start-up", "order 2 start-up"):
-            # a new IDA starts at order 1 with short steps: not measured
-            self.phase = "order 5" if self.phase == "start-up" else "order 2"
+        if self.phase == "start-up":  # a new IDA starts at order 1 with short steps
+            self.phase = "order 5"
             return None
-        if self.phase == "order 5":
-            self.rate5 = dt
-            if dt * self.omega_max >= self.STABILITY_HW:
-                self.decided = True
-                self.note = (f"order 5: accuracy-bound steps (h ω_max = "
-                             f"{dt * self.omega_max:.3g})")
-                return None
-            self.phase = "order 2 start-up"
-            self.order = 2
-            return 2
-        self.rate2 = dt
         self.decided = True
-        if dt > self.GAIN * self.rate5:
-            self.note = (f"order 2: order 5 was stability-bound (h ω_max = "
-                         f"{self.rate5 * self.omega_max:.3g}), order 2 took {dt / self.rate5:.3g}"
-                         " times longer steps")
-            return None
-        self.order = 5
-        self.note = (f"order 5: stability-bound (h ω_max = {self.rate5 * self.omega_max:.3g}) "
-                     f"but order 2 took only {dt / self.rate5:.3g} times longer steps")
-        return 5
+        hw = h * self.omega_max
+        per_period = 2.0 * np.pi / (h * self.omega_1) if h > 0 else np.inf
+        if hw < self.STABILITY_HW and per_period > self.STEPS_PER_PERIOD:
+            self.order = 2
+            self.note = (f"order 2 from t = {t:.6g} s: order 5 was stability-bound (h ω_max = "
+                         f"{hw:.3g}) at {per_period:.3g} steps per period of the lowest mode")
+            return 2
+        self.note = (f"order 5: h ω_max = {hw:.3g}, {per_period:.3g} steps per period of the "
+                     "lowest mode")
+        return None
 
     def summary(self) -> str:
         return self.note or f"order {self.order} ({self.phase}: too few steps to measure)"
