@@ -165,10 +165,11 @@ def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, 
 def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") -> xr.DataTree:
     """Root with provenance and one group per step, in step order.
 
-    Every group also says ``Conventions`` and has a ``title``, so that a group written as a
-    file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them.
+    Every group also has ``Conventions``, ``history`` and a ``title``, so that a group written
+    as a file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them.
     """
     created = datetime.now(UTC).isoformat(timespec="seconds")
+    history = f"{created} catdae {__version__}: run of case {case.name!r} ({status})"
     root = xr.Dataset(attrs=clean_attrs({
         "title": case.title,
         "source": case.source,
@@ -178,10 +179,11 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
         "created": created,
         "status": status,
         "Conventions": CONVENTIONS,
-        "history": f"{created} catdae {__version__}: run of case {case.name!r} ({status})",
+        "history": history,
     }))
-    groups = {k: v.assign_attrs(Conventions=CONVENTIONS, title=f"{case.title or case.name}: "
-                                f"step {k}") for k, v in groups.items()}
+    groups = {k: v.assign_attrs(Conventions=CONVENTIONS, history=history,
+                                title=f"{case.title or case.name}: step {k}")
+              for k, v in groups.items()}
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 
 

@@ -280,6 +280,8 @@ def test_every_group_passes_the_cf_checker(written, tmp_path):
     for name in back.children:
         f = tmp_path / f"{name}.nc"
         back[name].to_dataset().to_netcdf(f, engine="netcdf4")
+        assert back[name].attrs["Conventions"] == back.attrs["Conventions"]
+        assert back[name].attrs["history"] == back.attrs["history"]
         failed, score = _cf_high_priority_failures(f, "cf:1.8")
         assert failed == [], (name, failed)
         assert score > 0.95, (name, score)
