@@ -111,6 +111,16 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     return tree
 
 
+def check_case(case: Case):
+    """What ``catdae check`` judges before any work: the mesh (with form-found lengths at
+    their estimates, which also reject targets an isolated cable cannot reach) and what the
+    steps need of it. Returns the mesh; raises CaseError with the field paths."""
+    local = formfind.initial_lengths(to_gravity_frame(case)[0])
+    mesh = build_mesh(local)
+    check_steps(local, mesh)
+    return mesh
+
+
 def check_steps(case: Case, mesh) -> None:
     """What the steps need of the scene, judged before any work (``catdae check`` too).
 

@@ -121,16 +121,11 @@ def _say_where(exc: BaseException, when: str) -> None:
 
 
 def _check(args) -> int:
-    from .analysis import check_steps
+    from .analysis import check_case
     from .case import load_case
-    from .formfind import initial_lengths
-    from .frame import to_gravity_frame
-    from .mesh import build_mesh
 
     case = load_case(Path(args.case))  # the command line always names a file
-    # form-found lengths: the estimates, which also reject targets an isolated cable misses
-    mesh = build_mesh(initial_lengths(to_gravity_frame(case)[0]))
-    check_steps(case, mesh)
+    mesh = check_case(case)
     print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
           f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
     return 0

@@ -615,6 +615,11 @@ class _Builder:
                     self.problem(where + ("output_interval",), "expected at most the step "
                                  f"duration {v.duration:g} s, found {v.output_interval:g}")
                 damping = None if v.damping is None else self.damping(v.damping, where)
+                order = v.max_order
+                if not (order == "auto" or (isinstance(order, int) and not isinstance(order, bool)
+                                            and 1 <= order <= 5)):
+                    self.problem(where + ("max_order",), 'expected "auto" or an integer from 1 '
+                                 f"to 5 (IDA's largest BDF order), found {_found(order)}")
                 extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,

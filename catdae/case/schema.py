@@ -133,7 +133,7 @@ class _TransientStep(BaseModel):
     rtol: Pos = 1e-6
     atol: Pos = 1e-8
     damping: TomlTable | None = None
-    max_order: Annotated[int, Field(ge=1, le=5)] | Literal["auto"] = "auto"
+    max_order: Any = "auto"  # "auto" or an integer 1-5 (checked by the builder)
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
