@@ -21,7 +21,7 @@ from pydantic import BaseModel, ValidationError
 
 from ..errors import CaseError
 from ..timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
-from .limits import MIN_TIME, FileProblem, confined, read_limited, size_problems
+from .limits import FileProblem, confined, read_limited, size_problems
 from .messages import _fmt_path, _found, _message, _short, _unknown
 from .model import (
     AXES,
@@ -605,10 +605,9 @@ class _Builder:
             self.problem(at, f"expected at least 2 points, found {len(t)}")
             return None
         for j in range(1, len(t)):
-            if not t[j] >= t[j - 1] + MIN_TIME:
-                self.problem(at, f"expected strictly increasing times, at least {MIN_TIME:g} s "
-                             "apart, "
-                             f"found {t[j - 1]:g} then {t[j]:g} (point {j})")
+            if not t[j] > t[j - 1]:
+                self.problem(at, "expected strictly increasing times, found "
+                             f"{t[j - 1]:g} then {t[j]:g} (point {j})")
                 return None
         return Table(tuple(float(x) for x in t), tuple(float(x) for x in value), v.file)
 
