@@ -12,6 +12,7 @@ import csv
 import math
 import re
 import unicodedata
+import warnings
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -570,8 +571,8 @@ class _Builder:
             tf = self.table(v, where)
         if tf is not None and not _finite(tf):
             self.problem(where, "its value, rate or second derivative overflows (not a "
-                         "finite number): check the amplitude against the duration or "
-                         "frequency")
+                         "finite number): check the amplitude against the duration, the "
+                         "frequency or the spacing of the points")
             return None
         return tf
 
@@ -609,7 +610,10 @@ class _Builder:
                 self.problem(at, "expected strictly increasing times, found "
                              f"{t[j - 1]:g} then {t[j]:g} (point {j})")
                 return None
-        return Table(tuple(float(x) for x in t), tuple(float(x) for x in value), v.file)
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            # points too close for their values overflow the spline: judged by _finite
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return Table(tuple(float(x) for x in t), tuple(float(x) for x in value), v.file)
 
     def read_csv(self, name: str, where: tuple) -> list[tuple[float, float]] | None:
         """Rows ``time, value`` of a CSV file; blank and ``#`` lines skipped, one header allowed.
