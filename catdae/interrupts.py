@@ -41,14 +41,15 @@ def _handler(signum, frame):
 @contextmanager
 def signals_as_interrupts() -> Iterator[None]:
     """SIGINT and SIGTERM raise Interrupted inside the block (main thread only; elsewhere a
-    no-op). The previous handlers are restored afterwards."""
+    no-op; an ignored signal stays ignored). The previous handlers are restored afterwards."""
     if threading.current_thread() is not threading.main_thread() or _State.installed:
         yield
         return
-    previous = {s: signal.getsignal(s) for s in SIGNALS}
+    # a signal the parent set to be ignored (SIGINT of a background job, nohup) stays ignored
+    previous = {s: h for s in SIGNALS if (h := signal.getsignal(s)) != signal.SIG_IGN}
     _State.installed, _State.stopping, _State.pending = True, False, None
     try:
-        for s in SIGNALS:
+        for s in previous:
             signal.signal(s, _handler)
         yield
     finally:

@@ -224,8 +224,7 @@ def _write_failure(data, path: Path, exc: RuntimeError) -> OSError:
     except OSError:
         free = None
     if free is not None and free < data.nbytes + (1 << 20):
-        return OSError(errno.ENOSPC, f"{os.strerror(errno.ENOSPC)} ({free} bytes free, about "
-                                     f"{data.nbytes} needed)")
+        return OSError(errno.ENOSPC, f"{os.strerror(errno.ENOSPC)} ({free} bytes free)")
     return OSError(errno.EIO, f"the netCDF library failed to write: {exc}")
 
 

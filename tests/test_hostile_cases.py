@@ -264,8 +264,8 @@ def test_time_functions_that_overflow_are_refused(tmp_path, capsys):
          "its value, rate or second derivative overflows"),
         ('{ kind = "ramp", duration = 1e-6, smooth = true, amplitude = 1e300 }',
          "loads[0].time", "overflows"),
-        ('{ kind = "table", t = [0.0, 1e-300], value = [0.0, 1.0] }', "loads[0].time.t",
-         "expected strictly increasing times, at least 1e-09 s apart"),
+        ('{ kind = "table", t = [0.0, 1e-300], value = [0.0, 1.0] }', "loads[0].time",
+         "overflows"),
     ]:
         invalid(scene(timed(time), steps=DYN), field, expected, tmp_path, capsys,
                 subprocess_check=False)

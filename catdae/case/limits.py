@@ -17,7 +17,7 @@ MAX_FILE_BYTES = 16 * 2**20  # a case file or a table file
 MAX_ELEMENTS_PER_CABLE = 10_000  # a transient at 1000 elements already costs ~670 s per s
 MAX_DOFS = 300_000  # 3 per node, all cables together
 MAX_STEP_BYTES = 2**30  # what one step keeps in memory and writes (float64 values)
-MIN_TIME = 1e-9  # s: shortest duration, output interval, ramp or table spacing
+MIN_TIME = 1e-9  # s: shortest step duration, output interval or ramp duration
 MAX_FREQUENCY = 1e9  # Hz, of a sine or cosine time function
 TABLE_ROOTS_ENV = "CATDAE_TABLE_ROOTS"  # more folders table files may be read from
 
