@@ -426,7 +426,8 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     atol[0::2] = step.atol
     atol[1::2] = step.atol * omega
     auto = step.max_order == "auto"
-    order_choice = OrderChoice(_highest_frequency(prob, t0, y0), omega) if auto else None
+    order_choice = (OrderChoice(_highest_frequency(prob, t0, y0), omega, float(step.rtol))
+                    if auto else None)
     options = dict(rtol=step.rtol, atol=atol, max_order=5 if auto else int(step.max_order),
                    max_num_steps=100000, linsolver=linsolver)
     if linsolver == "band":
@@ -610,7 +611,8 @@ class OrderChoice:
     the mean step h of the next window decides: order 5 is stability-bound where h ω_max <
     ``STABILITY_HW``, and it is following the mesh's fast modes rather than the motion where it
     also takes more than ``STEPS_PER_PERIOD`` steps per period of the lowest mode (2π/ω₁). Then
-    the rest of the step runs at order 2; otherwise order 5 stays (docs/theory.md §8.6;
+    the rest of the step runs at order 2; otherwise, and always at rtol < ``TIGHT_RTOL``, order
+    5 stays (docs/theory.md §8.6;
     measurements in benchmarks/speed_accuracy.md). ``order_choice`` says what was measured.
     """
 
@@ -618,15 +620,19 @@ class OrderChoice:
     STABILITY_HW = 2.5
     STEPS_PER_PERIOD = 1.0e4
 
-    def __init__(self, omega_max: float | None, omega_1: float):
+    TIGHT_RTOL = 1e-6  # below it order 5 is kept: its steps are set by accuracy there
+
+    def __init__(self, omega_max: float | None, omega_1: float, rtol: float):
         self.omega_max = omega_max
         self.omega_1 = omega_1
         self.order = 5
-        self.decided = omega_max is None
+        self.decided = omega_max is None or rtol < self.TIGHT_RTOL
         self.phase = "start-up"
         self.count = 0
         self.t_mark = None
-        self.note = "" if omega_max is not None else "no highest frequency: order 5 kept"
+        self.note = ("no highest frequency: order 5 kept" if omega_max is None else
+                     f"order 5: rtol {rtol:g} < {self.TIGHT_RTOL:g} (at tight tolerances order 5 "
+                     "takes far fewer steps)" if rtol < self.TIGHT_RTOL else "")
 
     def observe(self, t: float) -> int | None:
         """Called after every step at time t; returns the new order cap when it changes."""

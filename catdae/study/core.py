@@ -107,6 +107,8 @@ def _check_value(name: str, v) -> str | None:
         return None if ok else f"expected a finite number > 0, found {v!r}"
     if name in _CHOICES:
         return None if v in _CHOICES[name] else f"expected one of {_CHOICES[name]}, found {v!r}"
+    if name == "max_order" and v == "auto":
+        return None
     lo, hi = {"elements": (1, 10**6), "gauss_points": (1, 10), "max_order": (1, 5)}[name]
     ok = isinstance(v, int | np.integer) and not isinstance(v, bool) and lo <= v <= hi
     return None if ok else f"expected an integer from {lo} to {hi}, found {v!r}"
