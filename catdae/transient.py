@@ -29,12 +29,15 @@ velocity terms of Lagrange's equations for T = ½ vᵀ M(q) v:
 
 where an element's M_e depends on the nodes only through its chord c = x_j - x_i, so
 ∂T/∂u_j = -∂T/∂u_i = ½ v_eᵀ (∂M_e/∂c) v_e. ∂M_e/∂c is analytic (forward-mode differentiation of
-the segment formulas, in the element pass that builds M_e; docs/theory.md §7.6). The BDF order
-cap of ``max_order = "auto"``: OrderChoice (docs/theory.md §8.6). The undamped semi-discrete
-system is then
-conservative: the total energy (kinetic + strain + gravity, recorded as ``energy_total``) drifts
-only by the integration error, which shrinks as the tolerance tightens (tests). ``"paper"``
-reproduces the paper's equations for comparison; a lumped mass has no such terms.
+the segment formulas, in the element pass that builds M_e; docs/theory.md §7.6). The undamped
+semi-discrete system is then conservative: the total energy (kinetic + strain + gravity,
+recorded as ``energy_total``) drifts only by the integration error, which shrinks as the
+tolerance tightens (tests). ``"paper"`` reproduces the paper's equations for comparison; a
+lumped mass has no such terms.
+
+BDF order (``max_order = "auto"``, the default): OrderChoice measures whether order 5 is held
+down by the stability of the mesh's fast modes and then goes on at order 2 (docs/theory.md
+§8.6).
 """
 
 from __future__ import annotations
