@@ -775,31 +775,10 @@ def _mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmpt
         if stat[e] != CONVERGED:
             continue
         he = h[e]
-        # the least tension along the element: ∂M/∂c grows like 1/t_min near a free end and
-        # is undefined at zero tension; fade it out smoothly (C1) between t_min = 1e-2 and
-        # 1e-3 of t_max, so that the residual stays continuous; those elements then follow
-        # the paper's M(q) v' form
-        hx = he[0]
-        hy = he[1]
-        vi = he[2]
-        vj = he[2] + w[e] * l0[e]
-        for k in range(ptr[e], ptr[e + 1]):
-            hx -= lf[k, 0]
-            hy -= lf[k, 1]
-            vj -= lf[k, 2]
-        t_i = np.sqrt(he[0] * he[0] + he[1] * he[1] + vi * vi)
-        t_j = np.sqrt(hx * hx + hy * hy + vj * vj)
-        t_min = min(t_i, t_j)
-        if vi * vj < 0.0:
-            t_min = min(t_min, np.sqrt(min(he[0] * he[0] + he[1] * he[1], hx * hx + hy * hy)))
-        t_max = max(t_i, t_j)
-        ratio = t_min / t_max if t_max > 0.0 else 0.0
-        if not ratio > 1e-3:
+        fade = _gradient_fade(he, w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])  # near zero tension
+        if fade == 0.0:
             continue
-        fade = 1.0
-        if ratio < 1e-2:
-            xf = np.log10(ratio) + 3.0  # 0 .. 1
-            fade = xf * xf * (3.0 - 2.0 * xf)
+        t_max = np.sqrt(he[0] * he[0] + he[1] * he[1] + he[2] * he[2]) + abs(w[e] * l0[e])
         for k in range(3):
             kc = np.sqrt(kmat[e, 0, k] ** 2 + kmat[e, 1, k] ** 2 + kmat[e, 2, k] ** 2)
             if not (kc > 0.0) or not np.isfinite(kc):
