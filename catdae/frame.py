@@ -1,6 +1,6 @@
 """Gravity along any direction: the scene is solved in a frame where gravity acts along -z.
 
-The element kernel (formulation.md §1-2) carries the weight along its -z axis: the tension
+The element kernel (docs/theory.md §1-2) carries the weight along its -z axis: the tension
 vector is ``t(s) = h + (0, 0, w s) - Σ f_k``. A case whose ``gravity`` is a vector ``g`` is
 rotated, as a rigid body, into the frame where ``g`` points along -z; it is solved there and its
 vector results are rotated back. A rotation changes nothing physical, so this is exact.

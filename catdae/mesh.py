@@ -114,7 +114,7 @@ class Mesh:
         """Gauss-Legendre points of the part [from_s, to_s] (unstrained arc length, m) of a cable.
 
         Every element that the part overlaps gets its own ``gauss_points`` points on the overlap
-        alone (formulation.md §5 on the covered sub-interval): the integration is split at the
+        alone (docs/theory.md §5 on the covered sub-interval): the integration is split at the
         ends of the coverage, so a load ending inside an element is integrated as accurately as
         one covering it whole, which is then the element's usual rule. Returns the element of
         each point (k,) int, its local arc length (k,) m and its weight times the overlap length
