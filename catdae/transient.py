@@ -666,20 +666,29 @@ class OrderChoice:
         return self.note or f"order {self.order} ({self.phase}: too few steps to measure)"
 
 
-def _highest_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float | None:
-    """ω_max of the free dofs about the start (rad/s), to 1 %, or None if it cannot be had."""
+def _extreme_frequency(prob: TransientProblem, t0: float, y0: np.ndarray,
+                       highest: bool) -> float | None:
+    """ω (rad/s) of the lowest (or the highest) mode of the free dofs about the start, or None
+    if it cannot be had. Dense below 400 unknowns; above, ARPACK from a fixed start vector
+    (its default is random, which made identical runs differ in their velocity atol and so in
+    their step counts): shift-invert about 0 for the lowest, largest algebraic (to 1 %) for the
+    highest."""
     conf = prob.configuration(t0, y0[0::2])
     if conf is None:
         return None
+    n = prob.n
     try:
         mff = prob.ff(prob.mass_data(conf))
         kff = prob.ff(prob.model.pattern.assemble(conf[0].stiffness6))
-        if prob.n <= 400:
+        if n <= 400:
+            k = n - 1 if highest else 0
             lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,
-                           subset_by_index=[prob.n - 1, prob.n - 1])[0]
+                           subset_by_index=[k, k])[0]
         else:
-            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), which="LA", tol=1e-2,
-                             v0=np.linspace(1.0, 2.0, prob.n), return_eigenvectors=False)[0]
+            v0 = np.linspace(1.0, 2.0, n)
+            opts = dict(which="LA", tol=1e-2) if highest else dict(sigma=0.0, which="LM")
+            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), v0=v0, return_eigenvectors=False,
+                             **opts)[0]
         if np.isfinite(lam) and lam > 0:
             return float(np.sqrt(lam))
     except (ValueError, RuntimeError, np.linalg.LinAlgError, spla.ArpackError):
@@ -687,24 +696,14 @@ def _highest_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> flo
     return None
 
 
+def _highest_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float | None:
+    """ω_max about the start (rad/s), or None: the stability scale of OrderChoice."""
+    return _extreme_frequency(prob, t0, y0, highest=True)
+
+
 def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:
-    """ω of the lowest mode about the start (rad/s): scales the velocity tolerance."""
-    conf = prob.configuration(t0, y0[0::2])
-    try:
-        mff = prob.ff(prob.mass_data(conf))
-        kff = prob.ff(prob.model.pattern.assemble(conf[0].stiffness6))
-        if prob.n <= 400:
-            lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,
-                           subset_by_index=[0, 0])[0]
-        else:
-            # a fixed start vector: ARPACK's default is random, which made identical runs
-            # differ in their velocity atol (last digits) and so in their step counts
-            v0 = np.linspace(1.0, 2.0, prob.n)
-            lam = spla.eigsh(kff.tocsc(), 1, mff.tocsc(), sigma=0.0, which="LM", v0=v0,
-                             return_eigenvectors=False)[0]
-        if np.isfinite(lam) and lam > 0:
-            return float(np.sqrt(lam))
-    except (ValueError, RuntimeError, np.linalg.LinAlgError, spla.ArpackError):
-        pass
-    return 2.0 * np.pi
+    """ω of the lowest mode about the start (rad/s): scales the velocity tolerance (2π if it
+    cannot be had)."""
+    omega = _extreme_frequency(prob, t0, y0, highest=False)
+    return 2.0 * np.pi if omega is None else omega
 
