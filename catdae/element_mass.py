@@ -298,6 +298,40 @@ def _mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, 
 
 
 @njit(cache=True)
+def _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
+                  pmptr, pms, pmm, want_m, want_c, want_dm, fflat, kmat, its, stat, mout, cout,
+                  dout, x, g6, fg, dkk, gm, bm, fm, nm, dn):
+    """Element e of ``_dynamics_batch`` (work arrays from the caller); with ``want_m`` False
+    only the solve (a lumped or constant mass)."""
+    its[e], stat[e] = _solve_one(
+        chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h[e], use_h, tol,
+        max_iter, fflat[e], kmat[e],
+    )
+    if not want_m:
+        return
+    slack = stat[e] == SLACK
+    done = False
+    if want_dm:
+        fade = 0.0
+        if stat[e] == CONVERGED:
+            fade = _gradient_fade(h[e], w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])
+        if fade > 0.0:
+            done = _mass_grad_one(h[e], kmat[e], l0[e], ea[e], w[e], ls, lf, ptr[e],
+                                  ptr[e + 1], gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1],
+                                  pms, pmm, fade, mout[e], dout[e], g6, fg, dkk, gm, bm,
+                                  nm, dn, fm)
+        if not done:
+            dout[e, :, :, :] = 0.0
+    if not done:
+        _mass_one(h[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+                  gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mout[e], x,
+                  g6)
+    if want_c:
+        _mass_one(h[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+                  gs[e], gw[e], cq[e], 0, 0, pms, pmm, False, cout[e], x, g6)
+
+
+@njit(cache=True)
 def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
                     pmptr, pms, pmm, want_c, want_dm, fflat, kmat, its, stat, mout, cout, dout):
     """Solve every element and build its consistent mass (and damping) matrix (§6-7), and
@@ -316,30 +350,9 @@ def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, 
     nm = np.empty((3, 6))
     dn = np.empty((3, 6))
     for e in range(chord.shape[0]):
-        its[e], stat[e] = _solve_one(
-            chord[e], l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h[e], use_h, tol,
-            max_iter, fflat[e], kmat[e],
-        )
-        slack = stat[e] == SLACK
-        done = False
-        if want_dm:
-            fade = 0.0
-            if stat[e] == CONVERGED:
-                fade = _gradient_fade(h[e], w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])
-            if fade > 0.0:
-                done = _mass_grad_one(h[e], kmat[e], l0[e], ea[e], w[e], ls, lf, ptr[e],
-                                      ptr[e + 1], gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1],
-                                      pms, pmm, fade, mout[e], dout[e], g6, fg, dkk, gm, bm,
-                                      nm, dn, fm)
-            if not done:
-                dout[e, :, :, :] = 0.0
-        if not done:
-            _mass_one(h[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
-                      gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mout[e], x,
-                      g6)
-        if want_c:
-            _mass_one(h[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
-                      gs[e], gw[e], cq[e], 0, 0, pms, pmm, False, cout[e], x, g6)
+        _dynamics_one(e, chord[e], l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq,
+                      cq, pmptr, pms, pmm, True, want_c, want_dm, fflat, kmat, its, stat, mout,
+                      cout, dout, x, g6, fg, dkk, gm, bm, fm, nm, dn)
 
 
 @njit(cache=True)

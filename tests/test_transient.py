@@ -289,14 +289,14 @@ def test_failure_keeps_partial_results(tmp_path, monkeypatch):
     outputs up to then, says why, and never overwrites an existing file."""
     from catdae import transient
 
-    orig = transient.TransientProblem.configuration
+    orig = transient.TransientProblem.evaluate  # where a transient solves its elements
 
-    def failing(self, t, q):
+    def failing(self, t, y, yp, res):
         if t > 0.05:
-            return None
-        return orig(self, t, q)
+            return False
+        return orig(self, t, y, yp, res)
 
-    monkeypatch.setattr(transient.TransientProblem, "configuration", failing)
+    monkeypatch.setattr(transient.TransientProblem, "evaluate", failing)
     out = tmp_path / "run.nc"
     out.write_text("previous results")
     text = taut_case(loads_y=2.0, steps=release_steps(0.2, 0.01, rtol=1e-6, atol=1e-8))
