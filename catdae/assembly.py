@@ -13,7 +13,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import minimize_scalar
 
 from .case import Case
 from .element import Elements, ElementState, PointLoads
@@ -493,6 +492,8 @@ class Model:
                     q = np.zeros((mesh.n_elements, 1))
                     q[e, 0] = sv
                     return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
+
+                from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
 
                 best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
                                        options={"xatol": 1e-10 * mesh.L0[e]})

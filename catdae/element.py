@@ -324,7 +324,9 @@ def kernels_cached() -> bool:
     and machine (False: the first call compiles them, about a minute). Uses numba's cache
     index; if that cannot be read, answers True (nothing to announce)."""
     try:
-        for f in (_solve_batch, _dynamics_batch, _dynamic_forces, _partial_batch):
+        from .residual_kernel import residual_pass
+
+        for f in (_solve_batch, _dynamics_batch, _dynamic_forces, _partial_batch, residual_pass):
             if not f._cache._cache_file._load_index():
                 return False
     except Exception:  # numba internals changed: do not guess

@@ -37,7 +37,6 @@ from collections.abc import Mapping
 from dataclasses import replace
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .case import AXES, Case
 from .case.build import MAX_STRAIN
@@ -143,6 +142,8 @@ def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
         if np.isfinite(d[k]) and np.isfinite(d[k + 1]) and d[k] * d[k + 1] <= 0.0:
             if d[k] == 0.0:
                 return float(ratios[k] * lc), ""
+            from scipy.optimize import brentq  # lazy: 0.5-1 s to import
+
             length = brentq(lambda x: float(q_of(x)[0]) - target, ratios[k] * lc,
                             ratios[k + 1] * lc, xtol=1e-14 * lc, rtol=1e-14)
             return float(length), ""

@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .timefunc import TimeFunction
 
@@ -115,6 +114,8 @@ class VelocityRecord(TimeFunction):
 
     def __post_init__(self):
         ts = np.asarray(self.t, float)
+        from scipy.interpolate import CubicSpline  # lazy: only for records
+
         spline = CubicSpline(ts, np.asarray(self.value, float), bc_type="not-a-knot")
         disp = spline.antiderivative()  # zero at t[0]
         # A cache derived from the frozen fields, set once here and never changed.

@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
-from scipy.interpolate import CubicSpline
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicSpline
 
 __all__ = [
     "ONE",
@@ -189,6 +191,8 @@ class Table(TimeFunction):
     _spline: CubicSpline = field(init=False, repr=False, compare=False, hash=False)
 
     def __post_init__(self):
+        from scipy.interpolate import CubicSpline  # lazy: only for tables
+
         spline = CubicSpline(np.asarray(self.t, float), np.asarray(self.value, float),
                              bc_type="not-a-knot")
         # A cache derived from the frozen fields, set once here and never changed.
