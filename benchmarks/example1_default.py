@@ -13,7 +13,8 @@ within 1 mm (max over the 4 s, output every 0.01 s) of a converged reference.
 - Reference: the same case at ``--ref-elements`` (224) elements, blended mass, BDF order 5,
   rtol 1e-7, atol 1e-9 m. Its own accuracy is stated by the differences from the same
   tolerances at half the elements (mesh) and from rtol 1e-8 at half the elements (time).
-  Reference arrays are cached in ``--cache`` (an .npz, keyed by the settings).
+  Reference arrays are cached in ``--cache`` (an .npz, keyed by elements and tolerances
+  only: delete it when the case's scene or damping changes).
 - ``--table``: the error and CPU of 14, 20, 28, 36 and 42 elements at the previous settings
   (rtol 1e-4, atol 1e-6, max_order "auto") and at the shipped ones.
 
