@@ -67,3 +67,22 @@ def test_violent_example2_water_hammer_jump_and_front_at_the_far_end(mass_model)
     assert arrival == pytest.approx(L0 / C, abs=2 * transit)
     before = t < L0 / C - 4 * transit
     assert np.abs(rise[before]).max() < 0.01 * jump
+
+
+# ------------------------------------------------------------------------------------------------
+# Example 1: the release with the case's blended mass at rtol 1e-4
+# ------------------------------------------------------------------------------------------------
+def test_example1_release_within_its_stated_time_integration_error():
+    """The case file: the midspan history within about 0.2 mm of a converged run of this mesh
+    (README: the error follows the tolerance, about rtol m). The reference is the same 14
+    elements at rtol 1e-8 over the whole 4 s (measured: 0.13 mm of 58.6 mm peak-to-peak)."""
+    case = catdae.load_case(CASES / "example1_free_vibration.toml")
+    case = dataclasses.replace(case, steps=case.steps[:2])  # the static step and the release
+    assert [s.name for s in case.steps] == ["hanging", "release"]
+    z = {}
+    for rtol, atol in ((None, None), (1e-8, 1e-10)):
+        ds = catdae.run(case, rtol=rtol, atol=atol, progress=False)["release"].ds
+        assert ds.attrs["mass_model"] == "blended"
+        z[rtol] = ds.displacement.sel(node="main.7", axis="z").values
+    assert np.ptp(z[1e-8]) > 0.05  # the motion: 58.6 mm peak to peak
+    assert np.abs(z[None] - z[1e-8]).max() < 2e-4
