@@ -3,6 +3,7 @@ and the case files state, each checked against an independent reference (a close
 converged mesh computed here). The measurements behind every tolerance are in
 benchmarks/nothing_lost.md (benchmarks/nothing_lost.py reproduces them).
 
+- The gentle example 2 at its 10 elements against a fine mesh over the paper's 4 s (Fig. 9).
 - The violent example 2 with a mass model that carries axial waves (the case's lumped mass, or
   the linear one): the velocity jump aπ of support A at t = 0 sends a water-hammer wave along
   the cable, a tension jump m c Δv_t (Δv_t the jump along the cable at A, c = sqrt(EA/m)), whose
@@ -30,6 +31,43 @@ def _bundled(name: str, **step_changes):
     steps = tuple(dataclasses.replace(s, **step_changes) if s.kind == "transient" else s
                   for s in case.steps)
     return dataclasses.replace(case, steps=steps)
+
+
+# ------------------------------------------------------------------------------------------------
+# The gentle example 2 (the paper's Fig. 9): 10 elements against a fine mesh over 4 s
+# ------------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def gentle():
+    """Midspan y of the bundled case (consistent mass, rtol 1e-5) at 10 and 50 elements.
+
+    50 elements are the converged mesh for y: 100 elements (370 s of CPU, too slow here) are
+    0.55 mm from them (0.8 % of the 68.7 mm peak) and their peaks agree to 0.02 %. Not for z:
+    there 50 and 100 elements are 2.3 mm apart (14 % of the 16.6 mm peak) and the lumped mass
+    at 50 elements is 2.9 mm from both, so z is left to benchmarks/nothing_lost.md."""
+    out = {}
+    for n in (10, 50):
+        ds = catdae.run(CASES / "example2_support_motion_gentle.toml", elements=n,
+                        progress=False)["excitation"].ds
+        assert ds.attrs["mass_model"] == "consistent"  # the package's default
+        out[n] = ds.displacement.sel(node=f"cable.{n // 2}", axis="y").values
+    assert out[50].size == 401  # 4 s every 0.01 s
+    return out
+
+
+def test_gentle_example2_10_elements_peak_within_5_percent_of_a_fine_mesh(gentle):
+    """Issue 11: the 10-element peak response within 5 % of a converged mesh's over the
+    paper's 4 s (measured: +0.64 % against 50 elements, +0.66 % against 100)."""
+    peak10, peak50 = np.abs(gentle[10]).max(), np.abs(gentle[50]).max()
+    assert peak50 == pytest.approx(0.0687, abs=5e-4)
+    assert peak10 == pytest.approx(peak50, rel=0.05)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the history, point by point, is not within 5 % of the peak at 10 elements: 6.4 mm of "
+    "68.7 mm (9.3 %; 9.5 % against 100 elements); "
+    "the peak is (test above), and tests/test_support_jump.py holds the history to 12 %"))
+def test_gentle_example2_10_elements_history_within_5_percent_of_the_peak(gentle):
+    assert np.abs(gentle[10] - gentle[50]).max() < 0.05 * np.abs(gentle[50]).max()
 
 
 # ------------------------------------------------------------------------------------------------
