@@ -82,7 +82,7 @@ ENERGY_MESHES = [10]  # --energy-50 adds 50 elements (minutes of CPU per run)
 def row(case: str, quantity: str, measured: str, claim: str, ok: bool | None, cost: str = ""):
     verdict = {True: "pass", False: "**FAIL**", None: "no claim"}[ok]
     ROWS.append((case, quantity, measured, claim, verdict, cost))
-    print(" | ".join(map(str, ROWS[-1])), flush=True)
+    print("| " + " | ".join(str(x).replace("|", "\\|") for x in ROWS[-1]) + " |", flush=True)
 
 
 def cost(*runs) -> str:
