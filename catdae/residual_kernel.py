@@ -3,7 +3,7 @@
 IDA calls the residual thousands of times per simulated second. Done as separate NumPy steps
 (scatter the unknowns, chords, element solve, mass, forces, gather) it spent as much time in
 Python between the compiled kernels as in them on meshes of tens of elements
-(benchmarks/speed_accuracy.md §5). ``residual_pass`` does all of it in one call and leaves the
+(benchmarks/speed_accuracy.md §7). ``residual_pass`` does all of it in one call and leaves the
 element state (tensions, flexibilities, stiffnesses, masses, ∂M/∂c) in the caller's buffers,
 where the iteration matrix and the outputs find it.
 """
