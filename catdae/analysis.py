@@ -79,7 +79,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 find_forms = False
             else:
                 model = Model(local, mesh.heated(local, temperature), absent,
-                              mass_model=step.mass_model)
+                              mass_model=step.mass_model, kind=step.kind)
                 ds = _run_step(step, model, state, writer, progress)
             ds = rotate_back(ds, rotation)
         except KeyboardInterrupt as exc:
@@ -135,7 +135,7 @@ def check_steps(case: Case, mesh) -> None:
         absent = (absent - set(step.add)) | set(step.remove)
         if step.kind != "transient":
             continue
-        model = Model(case, mesh, absent, mass_model=step.mass_model)
+        model = Model(case, mesh, absent, mass_model=step.mass_model, kind=step.kind)
         massless = model.lumped_mass_diag().reshape(-1, 3)[:, 0] <= 0.0
         free = ~model.fixed_mask.all(axis=1)
         names = [mesh.node_names[k] for k in np.flatnonzero(massless & free)]
@@ -200,6 +200,8 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     sol = solve_modal(model, state.X, est, step.modes)
     return results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
                                  {"solver": sol.solver, "mass_model": model.mass_model,
+                                  "mass_model_setting": model.mass_model_setting,
+                                  "mass_model_choice": model.mass_model_choice,
                                   "status": "completed"})
 
 

@@ -25,6 +25,35 @@ from .timefunc import TimeFunction
 BLEND_LUMPED = 0.5
 
 
+def free_hanging_ends(case: Case, mesh: Mesh, node_mass: np.ndarray) -> list[str]:
+    """Names of the nodes that end one element and nothing else: on no other element, with no
+    support on any axis and no point mass on them (``node_mass`` (n_nodes,) kg). A cable hangs
+    free there, with zero tension at the tip (unless a load pulls it)."""
+    degree = np.bincount(mesh.conn.ravel(), minlength=mesh.n_nodes)
+    supported = np.zeros(mesh.n_nodes, bool)
+    for node, axes in case.supports.items():
+        if axes:
+            supported[mesh.node_index(node)] = True
+    tips = (degree == 1) & ~supported & (node_mass <= 0.0)
+    return [mesh.node_names[k] for k in np.flatnonzero(tips)]
+
+
+def choose_mass_model(setting: str, kind: str, ends: list[str]) -> tuple[str, str]:
+    """The mass model of a step and why: ``setting`` as given, or for ``"auto"`` (the default,
+    docs/case-format.md, mass_model) "blended", except with a free-hanging end (``ends``, from
+    :func:`free_hanging_ends`): "consistent" for a modal step (the blend's lumped half puts
+    mass on the tip, which has no lateral stiffness, and adds a spurious mode), "lumped" for a
+    transient step (the consistent part breaks causality and the work-energy balance there;
+    tests/test_extremes.py measures both). Returns (model, choice)."""
+    if setting != "auto":
+        return setting, "set by the step"
+    if not ends:
+        return "blended", "auto: blended (no free-hanging end)"
+    shown = ", ".join(ends[:3]) + (f" and {len(ends) - 3} more" if len(ends) > 3 else "")
+    chosen = "consistent" if kind == "modal" else "lumped"
+    return chosen, f"auto: {chosen} (free-hanging end at {shown})"
+
+
 class Pattern:
     """CSR sparsity of element 6x6 blocks plus the diagonal, with a scatter map.
 
@@ -176,12 +205,21 @@ def build_loading(case: Case, mesh: Mesh, absent: set[str]) -> Loading:
 class Model:
     """What one analysis step sees: mesh, active loading, supports and their motion."""
 
-    def __init__(self, case: Case, mesh: Mesh, absent: set[str], mass_model: str = "consistent"):
-        """``absent``: names of the point masses and loads not present in this step."""
+    def __init__(self, case: Case, mesh: Mesh, absent: set[str], mass_model: str = "auto",
+                 kind: str = "transient"):
+        """``absent``: names of the point masses and loads not present in this step;
+        ``mass_model`` "auto" is resolved for a step of ``kind`` (:func:`choose_mass_model`):
+        ``mass_model`` is then the model used, ``mass_model_choice`` says why."""
         self.case = case
         self.mesh = mesh
         self.loading = build_loading(case, mesh, absent)
-        self.mass_model = mass_model
+        self.mass_model_setting = mass_model
+        if mass_model == "auto":
+            ends = free_hanging_ends(case, mesh, self.loading.node_mass)
+        else:
+            ends = []
+        self.mass_model, self.mass_model_choice = choose_mass_model(mass_model, kind, ends)
+        mass_model = self.mass_model
         # the blend's lumped fraction μ: M = (1 - μ) M_consistent + μ M_lumped
         self.lumped_fraction = {"blended": BLEND_LUMPED, "lumped": 1.0}.get(mass_model, 0.0)
         nn = mesh.n_nodes

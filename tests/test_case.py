@@ -185,9 +185,9 @@ def test_defaults():
     assert (static.load_steps, static.remove, static.duration) == (1, (), None)
     assert (transient.rtol, transient.atol, transient.max_order, transient.damping) == (
         1e-6, 1e-8, "auto", None)
-    assert (transient.linear_solver, transient.mass_model) == ("auto", "consistent")
+    assert (transient.linear_solver, transient.mass_model) == ("auto", "auto")
     modal = load_case(dump({**BASE, "steps": [{"kind": "modal"}]})).steps[0]
-    assert (modal.name, modal.modes, modal.mass_model) == ("modal0", 10, "consistent")
+    assert (modal.name, modal.modes, modal.mass_model) == ("modal0", 10, "auto")
     no_weight = load_case(dump(base(gravity=0.0)))
     assert no_weight.materials["strand"].weight == 0.0  # but the point mass keeps it defined
 

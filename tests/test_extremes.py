@@ -322,7 +322,10 @@ def _check_plumb(tree, ne):
     stretched = PLUMB_L + (PLUMB_M * G * PLUMB_L + PLUMB_m * G * PLUMB_L**2 / 2) / 1e8
     assert -zB == pytest.approx(stretched, rel=1e-10)
     np.testing.assert_allclose(st.position.sel(node="B", axis=["x", "y"]), 0.0, atol=1e-9)
-    f = tree["modes"].to_dataset().frequency.values
+    modes = tree["modes"].to_dataset()
+    # the bob sits on the free end: not a free-hanging end, so "auto" keeps the blend
+    assert modes.attrs["mass_model_choice"] == "auto: blended (no free-hanging end)"
+    f = modes.frequency.values
     pendulum = math.sqrt(G / stretched) / (2 * math.pi)  # line mass 2e-4 of the bob's
     np.testing.assert_allclose(f, pendulum, rtol=1e-3)
 
@@ -343,22 +346,30 @@ def test_free_chain_started_folded():
     assert float(st.position.sel(node="B", axis="z")) == pytest.approx(-20.0, abs=1e-3)
 
 
-def test_hanging_chain_modes_against_bessel():
+@pytest.mark.parametrize("mass_model", ["consistent", "auto"])
+def test_hanging_chain_modes_against_bessel(mass_model):
     """A chain hanging free (no end mass): tension zero at the free end, modes ω_n = (j_0,n / 2)
     sqrt(g / L) with j_0,n the zeros of J0 (Bessel). The consistent catenary mass converges to
     them at order about 2 from above (1.2e-2, 3.6e-3, 1.0e-3 on the first mode at 10, 20, 40
-    elements). The lumped and linear masses put mass on the free end node, which the element
-    holds with no lateral stiffness there (zero tension): they add a spurious mode and are not
-    checked here."""
+    elements). The lumped, linear and blended masses put mass on the free end node, which the
+    element holds with no lateral stiffness there (zero tension): they add a spurious mode
+    (blended, 10/20/40/80 elements: a second pair at 0.178/0.221/0.291/0.306 Hz or a third at
+    0.349/0.335/0.361/0.465 Hz where J0 gives 0.308 and 0.482 Hz) and are not checked here.
+    ``"auto"`` (the default) sees the free end and takes the consistent mass."""
     from scipy.special import jn_zeros
 
     L = 20.0
     exact = jn_zeros(0, 3) / 2 * math.sqrt(G / L) / (2 * math.pi)
     errors = []
     for ne in (10, 20, 40):
+        mm = "" if mass_model == "auto" else f'mass_model = "{mass_model}"\n'
         text = scene(B=(0.0, 0.0, -1.001 * L), L0=L, EA=1e9, mass=1.0, elements=ne,
-                     supports=("A",), steps=STATIC + modal(6))
-        f = catdae.run(text)["modes"].to_dataset().frequency.values
+                     supports=("A",), steps=STATIC + modal(6) + mm)
+        ds = catdae.run(text)["modes"].to_dataset()
+        assert ds.attrs["mass_model"] == "consistent"
+        if mass_model == "auto":
+            assert ds.attrs["mass_model_choice"] == "auto: consistent (free-hanging end at B)"
+        f = ds.frequency.values
         # x and y pairs, to the eigensolver's round-off on these lowest modes: about
         # eps * λ_max / λ_min ≈ 1e-6 (axial modes of EA = 1e9 against the pendulum modes);
         # 1e-9 held only while the dof order happened to make x and y bitwise alike
@@ -395,6 +406,7 @@ def _shaken_chain(mass_model):
     de = ds.energy_total.values - ds.energy_total.values[0]
     assert np.abs(work).max() > 0.1
     assert np.abs(de - work).max() < 0.01 * np.abs(work).max()
+    return ds
 
 
 @pytest.mark.parametrize("mass_model", ["lumped", "linear"])
@@ -402,15 +414,26 @@ def test_hanging_chain_shaken_at_the_top(mass_model):
     _shaken_chain(mass_model)
 
 
+def test_hanging_chain_shaken_at_the_top_auto_takes_lumped():
+    """The default "auto" sees the free-hanging end and takes the lumped mass (the blend and
+    the consistent mass fail this test: below)."""
+    ds = _shaken_chain("auto")
+    assert ds.attrs["mass_model"] == "lumped"
+    assert ds.attrs["mass_model_setting"] == "auto"
+    assert ds.attrs["mass_model_choice"] == "auto: lumped (free-hanging end at B)"
+
+
 @pytest.mark.xfail(strict=True, reason=(
     "free-hanging chain, consistent mass: the mass of its near-vertical, high-lambda^2 elements "
     "varies on a millimetre scale of lateral offset (M_zz +30 % for 1 mm on a 2 m element) and "
     "the tip element's grows like 1/T_tip; the run completes but the free end moves sideways at "
     "once (2.4 m within 1 s, before any wave can reach it) and ΔE - W is 54 J against 6 J of "
-    "work. "
-    "Use lumped or linear mass for transients of free-hanging chains"))
-def test_hanging_chain_shaken_at_the_top_consistent():
-    _shaken_chain("consistent")
+    "work; the blended mass (half consistent) does the same, less: the free end moves 0.128 m "
+    "within 1 s and ΔE - W is 0.55 J against 2.4 J of work. "
+    "Use lumped or linear mass for transients of free-hanging chains (auto does)"))
+@pytest.mark.parametrize("mass_model", ["consistent", "blended"])
+def test_hanging_chain_shaken_at_the_top_consistent(mass_model):
+    _shaken_chain(mass_model)
 
 
 @pytest.mark.parametrize("ne", [1, 4])
@@ -504,7 +527,9 @@ def test_taut_cable_free_vibration_over_1000_periods():
     y = ds.displacement.sel(node="c.1", axis="y").values
     up = np.flatnonzero((y[:-1] < 0) & (y[1:] >= 0))
     tc = t[up] - y[up] * (t[up + 1] - t[up]) / (y[up + 1] - y[up])
-    assert up.size >= n_per - 2
+    # the record holds n_per periods of the discrete model's frequency, not of the string's
+    # (2 elements: 1.3 % below it with the blended mass, above it with the consistent one)
+    assert up.size >= n_per * period * f_modal - 2
     f_record = (up.size - 1) / (tc[-1] - tc[0])
     # 1 % of a period of phase after 1000 periods
     assert f_record == pytest.approx(f_modal, rel=1e-2 / n_per), (f_record, f_modal)

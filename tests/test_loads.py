@@ -42,21 +42,29 @@ def mass_and_load(active_mass: bool = True) -> str:
             f'[[loads]]\nname = "P"\nnode = "c.1"\nforce = [0.0, {P!r}, 0.0]\nactive = false\n')
 
 
-def string_frequency(mass):
+# the cable's share of the midspan node's mass, per mass model: consistent 2 x (2/6) m L0/2 =
+# m L0/3 (a straight weightless element interpolates linearly), lumped 2 x m L0/4 = m L0/2,
+# blended the mean of the two, 5 m L0/12
+SHARE = {"consistent": 1.0 / 3.0, "lumped": 1.0 / 2.0, "blended": 5.0 / 12.0}
+
+
+def string_frequency(mass, mass_model="consistent"):
     """Natural frequency (Hz) of the midspan node: transverse stiffness 4T/SPAN of the two
-    straight prestressed halves (T/length each), mass ``mass`` plus the cable's consistent
-    share, 2 x (2/6) m L0/2 = m L0/3 (a straight weightless element interpolates linearly)."""
+    straight prestressed halves (T/length each), mass ``mass`` plus the cable's share
+    (``SHARE``) under ``mass_model``."""
     tension = EA * (SPAN / L0 - 1.0)
-    return math.sqrt(4.0 * tension / SPAN / (mass + M_CABLE * L0 / 3.0)) / (2.0 * math.pi)
+    share = SHARE[mass_model] * M_CABLE * L0
+    return math.sqrt(4.0 * tension / SPAN / (mass + share)) / (2.0 * math.pi)
 
 
-def test_suddenly_applied_load_peaks_at_twice_the_static_deflection():
+@pytest.mark.parametrize("mass_model", ["consistent", "blended"])
+def test_suddenly_applied_load_peaks_at_twice_the_static_deflection(mass_model):
     delta = string_deflection(P)
-    omega = 2.0 * math.pi * string_frequency(MASS)
+    omega = 2.0 * math.pi * string_frequency(MASS, mass_model)
     period = 2.0 * math.pi / omega
     steps = (static_step("before")
              + transient_step("sudden", 1.2 * period, period / 1000, rtol=1e-9, atol=1e-12,
-                              extra='add = ["P"]\n')
+                              extra=f'add = ["P"]\nmass_model = "{mass_model}"\n')
              + static_step("after"))
     tree = catdae.run(string_scene(mass_and_load(), steps))
     y0 = tree["before"].ds["displacement"].sel(node="c.1", axis="y").item()
@@ -73,24 +81,26 @@ def test_suddenly_applied_load_peaks_at_twice_the_static_deflection():
     assert y[0] == 0.0 and tr["velocity"].sel(node="c.1", axis="y").values[0] == 0.0
     # the load acts at full value from the first instant: a = P / M at t = 0
     a0 = tr["acceleration"].sel(node="c.1", axis="y").values[0]
-    assert a0 == pytest.approx(P / (MASS + M_CABLE * L0 / 3), rel=1e-9)
+    assert a0 == pytest.approx(P / (MASS + SHARE[mass_model] * M_CABLE * L0), rel=1e-9)
     # undamped, a constant load with its potential: the total energy is conserved
     e = tr["energy_total"].values
     assert np.ptp(e) < 1e-4 * P * delta
 
 
-def test_added_mass_lowers_the_frequency_and_a_removed_load_releases():
+@pytest.mark.parametrize("mass_model", ["consistent", "blended"])
+def test_added_mass_lowers_the_frequency_and_a_removed_load_releases(mass_model):
     # the mass is absent at first (a light string), then added; the load comes and goes
-    steps = ('[[steps]]\nkind = "modal"\nname = "bare"\nmodes = 1\n'
-             + '[[steps]]\nkind = "modal"\nname = "loaded"\nmodes = 1\nadd = ["M"]\n'
+    mm = f'mass_model = "{mass_model}"\n'
+    steps = ('[[steps]]\nkind = "modal"\nname = "bare"\nmodes = 1\n' + mm
+             + '[[steps]]\nkind = "modal"\nname = "loaded"\nmodes = 1\nadd = ["M"]\n' + mm
              + '[[steps]]\nkind = "static"\nname = "pushed"\nadd = ["P"]\n'
-             + transient_step("released", 1.2 / string_frequency(MASS), 0.001, rtol=1e-9,
-                              atol=1e-12, remove=["P"]))
+             + transient_step("released", 1.2 / string_frequency(MASS, mass_model), 0.001,
+                              rtol=1e-9, atol=1e-12, remove=["P"], extra=mm))
     tree = catdae.run(string_scene(mass_and_load(active_mass=False), steps))
-    assert tree["bare"].ds["frequency"].values[0] == pytest.approx(string_frequency(0.0),
-                                                                  rel=1e-6)
-    assert tree["loaded"].ds["frequency"].values[0] == pytest.approx(string_frequency(MASS),
-                                                                    rel=1e-6)
+    assert tree["bare"].ds["frequency"].values[0] == pytest.approx(
+        string_frequency(0.0, mass_model), rel=1e-6)
+    assert tree["loaded"].ds["frequency"].values[0] == pytest.approx(
+        string_frequency(MASS, mass_model), rel=1e-6)
     delta = string_deflection(P)
     pushed = tree["pushed"].ds["displacement"].sel(node="c.1", axis="y").item()
     assert pushed == pytest.approx(delta, rel=1e-9)

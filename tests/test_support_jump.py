@@ -52,10 +52,15 @@ def _smooth_start_table(tau: float, t_end: float) -> str:
     return f"z = {{ kind = \"table\", t = [{ts}], value = [{zs}] }}"
 
 
-def test_velocity_jump_is_the_limit_of_smooth_starts(tmp_path):
-    """Smooth starts over τ = 0.02, 0.01, 0.005 s tend to the jump's response, ∝ τ."""
+@pytest.mark.parametrize("mass_model", ["consistent", "blended"])
+def test_velocity_jump_is_the_limit_of_smooth_starts(tmp_path, mass_model):
+    """Smooth starts over τ = 0.02, 0.01, 0.005 s tend to the jump's response, ∝ τ. The bound
+    1e-3 of the response at τ = 0.005 was measured with the consistent mass; the blended one
+    gets there more slowly (1.9e-4, 5.4e-5, 1.7e-5 m: 1.02e-3 of 0.0167 m at τ = 0.005, order
+    1.7 in τ), so for it the test checks the limit itself: the order in τ."""
     n, dur = 10, 0.6
-    tol = {"rtol": 1e-8, "atol": 1e-10, "elements": n, "progress": False}
+    tol = {"rtol": 1e-8, "atol": 1e-10, "elements": n, "progress": False,
+           "mass_model": mass_model}
     jump = _midspan(catdae.run(_case(tmp_path, "jump", duration=dur), **tol), n)
     errors = []
     for tau in (0.02, 0.01, 0.005):
@@ -65,7 +70,8 @@ def test_velocity_jump_is_the_limit_of_smooth_starts(tmp_path):
         # compare after the start-up, where both have the same prescribed motion
         errors.append(np.abs(smooth[20:] - jump[20:]).max())
     scale = np.abs(jump).max()
-    assert errors[-1] < 1e-3 * scale, (errors, scale)
+    if mass_model == "consistent":
+        assert errors[-1] < 1e-3 * scale, (errors, scale)
     # at least first order in τ: halving τ at least about halves the difference
     rates = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
     assert np.all(rates > 0.7), (errors, rates)
@@ -76,10 +82,12 @@ def example2_runs(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("ex2")
     path = _case(tmp, "gentle", duration=4.0)
     out = {}
+    # the paper's mass (consistent), asked for: the paper's claims are checked with it
     for n in (10, 50):
-        out[n] = _midspan(catdae.run(path, elements=n, progress=False), n)
+        out[n] = _midspan(catdae.run(path, elements=n, mass_model="consistent",
+                                     progress=False), n)
     out["tight"] = _midspan(catdae.run(path, elements=10, rtol=1e-7, atol=1e-9,
-                                       progress=False), 10)
+                                       mass_model="consistent", progress=False), 10)
     return out
 
 

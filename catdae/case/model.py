@@ -18,7 +18,8 @@ from .limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from .messages import _found, _is_number
 
 AXES = ("x", "y", "z")
-MASS_MODELS = ("blended", "consistent", "lumped", "linear")  # docs/case-format.md, mass_model
+# docs/case-format.md, mass_model
+MASS_MODELS = ("auto", "blended", "consistent", "lumped", "linear")
 
 
 class FrozenMap(Mapping):
@@ -228,7 +229,7 @@ class Step:
     damping: Damping | None = None
     max_order: int | Literal["auto"] = "auto"
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
@@ -288,7 +289,7 @@ class Case:
     def with_overrides(self, rtol: float | None = None, atol: float | None = None,
                        elements: int | None = None, mass_model: str | None = None) -> Case:
         """A new Case with ``rtol``/``atol`` set on every transient step, ``mass_model``
-        ("consistent" or "lumped") on every transient and modal step, and ``elements`` on
+        (one of ``MASS_MODELS``) on every transient and modal step, and ``elements`` on
         every cable (``None`` leaves a setting as it is).
 
         With a new ``elements``, a load or point mass placed on a mesh node ``<cable>.<k>`` is
@@ -306,8 +307,8 @@ class Case:
             problems.append(("elements", f"expected an integer >= 1 and <= "
                              f"{MAX_ELEMENTS_PER_CABLE}, found {_found(elements)}"))
         if mass_model is not None and mass_model not in MASS_MODELS:
-            problems.append(("mass_model", 'expected "blended", "consistent", "lumped" or '
-                             f'"linear", found {_found(mass_model)}'))
+            problems.append(("mass_model", 'expected "auto", "blended", "consistent", '
+                             f'"lumped" or "linear", found {_found(mass_model)}'))
         if problems:
             raise CaseError(self.path, problems)
         steps = tuple(

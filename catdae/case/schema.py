@@ -118,7 +118,7 @@ class _ModalStep(BaseModel):
     temperature_change: Any = None
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
-    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
 
 
 class _TransientStep(BaseModel):
@@ -135,7 +135,7 @@ class _TransientStep(BaseModel):
     damping: TomlTable | None = None
     max_order: Any = "auto"  # "auto" or an integer 1-5 (checked by the builder)
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["blended", "consistent", "lumped", "linear"] = "consistent"
+    mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 

@@ -29,7 +29,7 @@ run in what the study varies: ``rtol`` and ``atol`` are 1/100 of the smallest sw
 when ``elements`` is swept (more than one value) it is ``2 * max(elements)``, otherwise the
 runs' own mesh, so that a tolerance sweep measures the time-integration error alone, not the
 spatial error of the mesh; a swept ``gauss_points`` becomes ``max + 1`` (at most 10), a swept
-``mass_model`` "consistent", a swept ``max_order`` 5, a swept ``linear_solver`` "auto". A
+``mass_model`` "auto", a swept ``max_order`` 5, a swept ``linear_solver`` "auto". A
 mapping ``reference={"elements": 128}`` overrides any of these; a Dataset (the study step's
 group of a catdae results file) is used as it is. The settings used are in the output attrs.
 

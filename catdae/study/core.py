@@ -30,7 +30,7 @@ _COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "linear_solver": ("", "linear solver requested"),
     "max_order": ("1", "largest BDF order of IDA"),
 }
-_CHOICES = {"mass_model": ("blended", "consistent", "lumped", "linear"),
+_CHOICES = {"mass_model": ("auto", "blended", "consistent", "lumped", "linear"),
             "linear_solver": ("auto", "band", "sparse", "dense")}
 _COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
 _MEMORY_NAMES = {
@@ -126,7 +126,7 @@ def reference_settings(grid: Mapping[str, list], overrides: Mapping | None = Non
         elif name == "gauss_points":
             ref[name] = min(max(values) + 1, 10) if swept else values[0]
         else:
-            ref[name] = {"mass_model": "consistent", "linear_solver": "auto",
+            ref[name] = {"mass_model": "auto", "linear_solver": "auto",
                          "max_order": 5}[name] if swept else values[0]
     for name, v in (overrides or {}).items():
         msg = (f"not a setting of this study (its settings: {', '.join(grid)})"
