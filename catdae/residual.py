@@ -53,6 +53,12 @@ from .transient_results import potential
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
 
 
+def _readonly(a: np.ndarray) -> np.ndarray:
+    v = np.ascontiguousarray(a, float).view()
+    v.flags.writeable = False
+    return v
+
+
 class TransientProblem:
     """Residual and iteration matrix of one transient step, with evaluation counters."""
 
@@ -415,6 +421,8 @@ class TransientProblem:
         """Positions, velocities, accelerations, tensions, reactions and energies at t (one
         compiled residual pass leaves the element state and forces in the buffers)."""
         m = self.model
+        # read-only views, as IDA passes them: one compiled signature of the pass, not two
+        y, yp = _readonly(y), _readonly(yp)
         if not self.evaluate(t, y, yp, self._res_scratch):
             raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
                               termination="element failure")
