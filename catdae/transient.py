@@ -221,11 +221,11 @@ class OrderChoice:
     (the axial modes of a fine mesh) force their step down, whatever the accuracy needs, and the
     steps per simulated second then grow with the mesh. BDF2 is A-stable (it damps the modes
     far above 1/h). The run starts at order 5; after IDA's start-up window of ``WINDOW`` steps
-    the mean step h of the next window decides: order 5 is stability-bound where h ω_max <
+    the mean step h of each following window decides: order 5 is stability-bound where h ω_max <
     ``STABILITY_HW``, and it is following the mesh's fast modes rather than the motion where it
     also takes more than ``STEPS_PER_PERIOD`` steps per period of the lowest mode (2π/ω₁). Then
-    the rest of the step runs at order 2; otherwise, and always at rtol < ``TIGHT_RTOL``, order
-    5 stays (docs/theory.md §8.6;
+    the rest of the step runs at order 2; otherwise order 5 goes on and the next window is
+    tested again. At rtol < ``TIGHT_RTOL`` order 5 stays (docs/theory.md §8.6;
     measurements in benchmarks/speed_accuracy.md). ``order_choice`` says what was measured.
     """
 
@@ -260,10 +260,13 @@ class OrderChoice:
         if self.phase == "start-up":  # a new IDA starts at order 1 with short steps
             self.phase = "order 5"
             return None
-        self.decided = True
+        # every later window at order 5 is tested again: an early window can be unrepresentative
+        # (IDA's first step scales with the step's duration, and order 5 may run long steps
+        # before the fast modes hold it down)
         hw = h * self.omega_max
         per_period = 2.0 * np.pi / (h * self.omega_1) if h > 0 else np.inf
         if hw < self.STABILITY_HW and per_period > self.STEPS_PER_PERIOD:
+            self.decided = True
             self.order = 2
             self.note = (f"order 2 from t = {t:.6g} s: order 5 was stability-bound (h ω_max = "
                          f"{hw:.3g}) at {per_period:.3g} steps per period of the lowest mode")
