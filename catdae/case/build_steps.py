@@ -1,0 +1,239 @@
+"""Pass 3 for the steps of a case: support motions, steps with their temperature, presence
+(add/remove) and damping. A mixin of :class:`~catdae.case.build._Builder`, whose
+``problem`` and ``validate`` collect what is wrong (see ``build``)."""
+
+from __future__ import annotations
+
+import re
+import unicodedata
+from typing import Any
+
+from .messages import _fmt_path, _found, _is_number, _short, _unknown
+from .model import (
+    AXES,
+    Damping,
+    FrozenMap,
+    Step,
+    SupportMotion,
+)
+from .schema import (
+    _DAMPING_MODELS,
+    _STEP_MODELS,
+    _SupportMotion,
+)
+
+
+class _StepsPass:
+    """Support motions and steps (methods of ``_Builder``)."""
+
+    def support_motions(self, raw: list[dict], nodes: dict, supports: dict) -> list:
+        out = []
+        seen: dict[str, int] = {}
+        for i, item in enumerate(raw):
+            where = ("support_motions", i)
+            v, ok = self.validate(_SupportMotion, item, where)
+            if v is None:
+                continue
+            if v.node not in self.node_names:
+                self.problem(where + ("node",), _unknown(v.node, "node", sorted(self.node_names)))
+                ok = False
+            elif v.node not in self.support_names:
+                self.problem(where + ("node",), f"node {v.node!r} is not supported; only a "
+                             "supported node can be moved (add it to [supports])")
+                ok = False
+            elif v.node in seen:
+                self.problem(where + ("node",), f"node {v.node!r} already moves in "
+                             f"support_motions[{seen[v.node]}]; give all its axes there")
+                ok = False
+            else:
+                seen[v.node] = i
+            if not any(axis in item for axis in AXES):
+                self.problem(where, "a support motion needs at least one of x, y, z")
+                ok = False
+            funcs = {}
+            fixed = supports.get(v.node)
+            for axis in AXES:
+                spec = getattr(v, axis)
+                if spec is None:
+                    continue
+                if fixed is not None and axis not in fixed:
+                    self.problem(where + (axis,), f"axis {axis!r} of node {v.node!r} is not "
+                                 f"fixed (fixed axes: {list(fixed)}); only a fixed axis can be "
+                                 "moved")
+                    ok = False
+                funcs[axis] = self.time_function(spec, where + (axis,), motion=True)
+                ok = ok and funcs[axis] is not None
+            if ok and fixed is not None:
+                out.append(SupportMotion(v.node, **funcs))
+        return out
+
+    def steps(self, raw: list[dict]) -> list[Step]:
+        out = []
+        names: dict[str, int] = {}
+        # what is present before each step, and why: the name -> (present, reason) of add/remove
+        presence = {r: (r not in self.inactive, "active = false" if r in self.inactive else
+                        "active from the start") for r in self.removable}
+        for i, item in enumerate(raw):
+            where = ("steps", i)
+            kind = item.get("kind")
+            if not isinstance(kind, str) or kind not in _STEP_MODELS:
+                if "kind" not in item:
+                    self.problem(where + ("kind",), "missing: this key is required (one of "
+                                 "'static', 'modal', 'transient')")
+                elif isinstance(kind, str):
+                    self.problem(where + ("kind",), _unknown(kind, "step kind", _STEP_MODELS))
+                else:
+                    self.problem(where + ("kind",), "expected 'static', 'modal' or "
+                                 f"'transient', found {_found(kind)}")
+                continue
+            model = _STEP_MODELS[kind]
+            foreign = {
+                key: f"does not apply to a {kind} step (it belongs to {other} steps)"
+                for other, m in _STEP_MODELS.items() if other != kind
+                for key in m.model_fields if key not in model.model_fields
+            }
+            v, complete = self.validate(model, item, where, foreign)
+            nm = item.get("name") if isinstance(item.get("name"), str) else f"{kind}{i}"
+            if nm in names:
+                self.problem(where + ("name",), f"duplicate step name {nm!r} (also "
+                             f"steps[{names[nm]}])")
+            elif not _group_name(nm):
+                self.problem(where + ("name",), "a step name names a group of the results "
+                             "file: expected a letter, digit or '_' first, then also '.', '-', "
+                             "'+', '@' or inner spaces (no '/'; netCDF group names), found "
+                             f"{_short(nm)}")
+            names.setdefault(nm, i)
+            if v is None:
+                continue
+            self.add_remove(v, where, nm, presence)
+            extra: dict[str, Any] = {}
+            if kind == "static":
+                extra = {"load_steps": v.load_steps}
+            elif kind == "modal":
+                extra = {"modes": v.modes, "mass_model": v.mass_model}
+            else:
+                if v.output_interval > v.duration:
+                    self.problem(where + ("output_interval",), "expected at most the step "
+                                 f"duration {v.duration:g} s, found {v.output_interval:g}")
+                damping = None if v.damping is None else self.damping(v.damping, where)
+                order = v.max_order
+                if not (order == "auto" or (isinstance(order, int) and not isinstance(order, bool)
+                                            and 1 <= order <= 5)):
+                    self.problem(where + ("max_order",), 'expected "auto" or an integer from 1 '
+                                 f"to 5 (IDA's largest BDF order), found {_found(order)}")
+                extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
+                         "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
+                         "max_order": v.max_order, "linear_solver": v.linear_solver,
+                         "mass_model": v.mass_model, "inertia": v.inertia}
+            temperature = self.temperature(v.temperature_change, where)
+            if complete and temperature is not False:
+                out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
+                                add=tuple(v.add), temperature_change=temperature,
+                                **extra))
+        return out
+
+    def temperature(self, raw: Any, where: tuple) -> float | FrozenMap | None | bool:
+        """A step's ``temperature_change``: K for every cable, or a table cable name -> K."""
+        where = where + ("temperature_change",)
+        if raw is None:
+            return None
+        if _is_number(raw):
+            return float(raw)
+        if not isinstance(raw, dict):
+            self.problem(where, "expected a temperature change in K (a number, for every "
+                         f"cable) or a table cable name -> K, found {_found(raw)}")
+            return False
+        ok = True
+        for key, value in raw.items():
+            if key not in self.cable_names:
+                self.problem(where + (key,), _unknown(key, "cable", sorted(self.cable_names)))
+                ok = False
+            elif not _is_number(value):
+                self.problem(where + (key,), f"expected a temperature change in K (a finite "
+                             f"number), found {_found(value)}")
+                ok = False
+        return FrozenMap({k: float(v) for k, v in raw.items()}) if ok else False
+
+    def form_first_step(self, cables: dict, steps: list[Step], raw_steps: list) -> None:
+        """Form-finding holds in the first static step, which must then come first."""
+        found = [c.name for _, c in cables.values()
+                 if c.form is not None and c.form.kind != "pretension"]
+        if found and raw_steps and raw_steps[0].get("kind") != "static":
+            self.problem(("steps", 0, "kind"), (
+                f"cable {found[0]!r} has its length found by form-finding, which holds in the "
+                "first step: expected a static step first, found "
+                f"{_found(raw_steps[0].get('kind'))}"))
+
+    def add_remove(self, v: Any, where: tuple, step: str, presence: dict) -> None:
+        """A step's ``add`` names what is absent before it, its ``remove`` what is present."""
+        here = f"step {step!r} ({_fmt_path(where)})"
+        for key in ("add", "remove"):
+            for j, r in enumerate(getattr(v, key)):
+                at = where + (key, j)
+                if r not in self.removable:
+                    if r in self.distributed_names:
+                        self.problem(at, f"{r!r} is the default name of an unnamed distributed "
+                                     f'load; give it name = "..." to {key} it')
+                    else:
+                        self.problem(at, _unknown(r, "point mass, load or distributed load",
+                                                  sorted(self.removable)))
+                    continue
+                if key == "remove" and r in v.add:
+                    self.problem(at, f"{r!r} is both added and removed by this step")
+                    continue
+                present, why = presence[r]
+                if key == "add" and present:
+                    self.problem(at, f"{r!r} is already present ({why}); add names what is "
+                                 "absent (active = false, or removed by an earlier step)")
+                elif key == "remove" and not present:
+                    if why == "active = false":
+                        why = "absent: it has active = false and no earlier step adds it"
+                    self.problem(at, f"{r!r} is {why}")
+                else:
+                    presence[r] = (key == "add", f"added by {here}" if key == "add"
+                                   else f"already removed by {here}")
+
+    def damping(self, raw: dict, step_where: tuple) -> Damping | None:
+        where = step_where + ("damping",)
+        kind = self.kind_of(raw, where, _DAMPING_MODELS, "damping kind")
+        if kind is None:
+            return None
+        v, complete = self.validate(_DAMPING_MODELS[kind], raw, where)
+        if not complete:
+            return None
+        if kind == "material":
+            return Damping("material")
+        pair = v.alpha is not None or v.beta is not None
+        ratio = v.ratio is not None or v.frequencies is not None
+        if pair and ratio:
+            self.problem(where, "give either alpha and beta, or ratio and frequencies, not both")
+            return None
+        if not pair and not ratio:
+            self.problem(where, "Rayleigh damping needs alpha and beta, or ratio and "
+                         "frequencies = [f1, f2] (Hz)")
+            return None
+        need = ("alpha", "beta") if pair else ("ratio", "frequencies")
+        missing = [k for k in need if getattr(v, k) is None]
+        for k in missing:
+            other = need[1] if k == need[0] else need[0]
+            self.problem(where + (k,), f"missing: needed together with {other}")
+        if missing:
+            return None
+        if ratio:
+            f1, f2 = v.frequencies
+            if abs(f1 - f2) <= 1e-12 * max(f1, f2):
+                self.problem(where + ("frequencies",), "expected two different frequencies, "
+                             f"found {f1:g} Hz twice")
+                return None
+            return Damping("rayleigh", ratio=float(v.ratio), frequencies=(float(f1), float(f2)))
+        return Damping("rayleigh", alpha=float(v.alpha), beta=float(v.beta))
+
+
+_GROUP_NAME = re.compile(r"\w[\w.+\-@ ]*")
+
+
+def _group_name(name: str) -> bool:
+    """A netCDF-4 group name that reads back as written: a letter, digit or '_' first (not
+    '$', '.', '-'), no '/', no trailing space, NFC, at most 255 bytes."""
+    return (_GROUP_NAME.fullmatch(name) is not None and not name.endswith(" ")
+            and unicodedata.is_normalized("NFC", name) and len(name.encode()) <= 255)

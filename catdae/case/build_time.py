@@ -1,0 +1,208 @@
+"""Pass 3 for time functions: their kinds, tables and the CSV files behind them. A mixin of
+:class:`~catdae.case.build._Builder`, whose ``problem`` and ``validate`` collect what is
+wrong (see ``build``)."""
+
+from __future__ import annotations
+
+import csv
+import math
+import warnings
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..records import AccelerationRecord, VelocityRecord
+from ..timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
+from .limits import FileProblem, confined, read_limited
+from .messages import _found, _short, _suggest, _unknown
+from .schema import (
+    _TIME_MODELS,
+    _TableTF,
+)
+
+
+class _TimePass:
+    """Time functions and tables (methods of ``_Builder``)."""
+
+    def kind_of(self, raw: dict, where: tuple, models: Mapping, what: str) -> str | None:
+        kind = raw.get("kind")
+        if isinstance(kind, str) and kind in models:
+            return kind
+        if "kind" not in raw:
+            self.problem(where + ("kind",), "missing: this key is required (one of "
+                         f"{', '.join(repr(k) for k in models)})")
+        elif isinstance(kind, str):
+            self.problem(where + ("kind",), _unknown(kind, what, models))
+        else:
+            self.problem(where + ("kind",), f"expected a string, found {_found(kind)}")
+        return None
+
+    def time_function(self, raw: dict, where: tuple, motion: bool = False
+                      ) -> TimeFunction | None:
+        """A time function; ``motion``: it prescribes a support's displacement (a ``table``
+        may then be a velocity or acceleration record)."""
+        kind = self.kind_of(raw, where, _TIME_MODELS, "time function kind")
+        if kind is None:
+            return None
+        v, complete = self.validate(_TIME_MODELS[kind], raw, where)
+        if not complete:
+            return None
+        if kind == "constant":
+            tf: TimeFunction | None = Constant(float(v.value))
+        elif kind == "ramp":
+            tf = Ramp(float(v.duration), float(v.start), v.smooth, float(v.amplitude))
+        elif kind in ("sine", "cosine"):
+            cls = Sine if kind == "sine" else Cosine
+            tf = cls(float(v.amplitude), float(v.frequency), float(v.phase), float(v.offset))
+        else:
+            tf = self.table(v, where, motion)
+        if tf is not None and not _finite(tf):
+            self.problem(where, "its value, rate or second derivative overflows (not a "
+                         "finite number): check the amplitude against the duration, the "
+                         "frequency or the spacing of the points")
+            return None
+        return tf
+
+    def table(self, v: _TableTF, where: tuple, motion: bool = False
+              ) -> Table | AccelerationRecord | VelocityRecord | None:
+        inline = v.t is not None or v.value is not None
+        if v.file is not None and inline:
+            self.problem(where, "give either file, or t and value, not both")
+            return None
+        if v.file is None and not inline:
+            self.problem(where, 'a table needs file = "points.csv" or inline t = [...] and '
+                         "value = [...]")
+            return None
+        if v.quantity != "displacement" and not motion:
+            self.problem(where + ("quantity",), f"quantity = {v.quantity!r} applies to support "
+                         "motions only; a load's time function is a factor that multiplies it")
+            return None
+        if v.column is not None and v.file is None:
+            self.problem(where + ("column",), "column selects a column of a table file; an "
+                         "inline table has one list of values")
+            return None
+        if v.file is not None:
+            rows = self.read_csv(v.file, where + ("file",), v.column, where + ("column",))
+            if rows is None:
+                return None
+            t, value, at = [r[0] for r in rows], [r[1] for r in rows], where + ("file",)
+        else:
+            for k in ("t", "value"):
+                if getattr(v, k) is None:
+                    self.problem(where + (k,), f"missing: needed together with "
+                                 f"{'value' if k == 't' else 't'}")
+            if v.t is None or v.value is None:
+                return None
+            t, value, at = v.t, v.value, where + ("t",)
+            if len(t) != len(value):
+                self.problem(where + ("value",), f"expected {len(t)} values, one per time in "
+                             f"t, found {len(value)}")
+                return None
+        if len(t) < 2:
+            self.problem(at, f"expected at least 2 points, found {len(t)}")
+            return None
+        for j in range(1, len(t)):
+            if not t[j] > t[j - 1]:
+                self.problem(at, "expected strictly increasing times, found "
+                             f"{t[j - 1]:g} then {t[j]:g} (point {j})")
+                return None
+        t, value = tuple(float(x) for x in t), tuple(float(x) for x in value)
+        if v.quantity == "acceleration":
+            return AccelerationRecord(t, value, v.file, v.column)
+        if v.quantity == "velocity":
+            return VelocityRecord(t, value, v.file, v.column)
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            # points too close for their values overflow the spline: judged by _finite
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return Table(t, value, v.file)
+
+    def read_csv(self, name: str, where: tuple, column: str | None = None,
+                 column_where: tuple = ()) -> list[tuple[float, float]] | None:
+        """Rows ``time, value`` of a CSV file; blank and ``#`` lines skipped, one header allowed.
+
+        With ``column``, the file has a header naming its columns (time first) and the value
+        is taken from the column of that name. The file must be a regular file inside the case's
+        folder (or a folder listed in CATDAE_TABLE_ROOTS) of at most MAX_FILE_BYTES; problems
+        name the line, never quote a data row.
+        """
+        try:
+            file = confined(name, self.base_dir)
+            raw = read_limited(file, "table file")
+        except FileProblem as exc:
+            self.problem(where, f"cannot read table file {_short(name)}: {exc}")
+            return None
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            self.problem(where, f"cannot read table file {_short(name)}: not UTF-8 text "
+                         f"(byte {exc.start})")
+            return None
+        lines = [(n, [c.strip() for c in row])
+                 for n, row in enumerate(csv.reader(text.splitlines()), start=1)]
+        lines = [(n, c) for n, c in lines if any(c) and not c[0].startswith("#")]
+        header: list[str] | None = None
+        if lines and not all(_is_float(c) for c in lines[0][1]):
+            header = lines[0][1]  # a header line such as "time,value" or "t,ax,ay,az"
+            lines = lines[1:]
+        width = len(header) if header is not None else len(lines[0][1]) if lines else 2
+        if column is None and width != 2:
+            names = f" ({', '.join(header)})" if header is not None else ""
+            self.problem(where, f"{name} has {width} columns{names}: choose the value column "
+                         'with column = "<name>" (time is the first column)')
+            return None
+        index = 1
+        if column is not None:
+            if header is None:
+                self.problem(column_where, f"column = {column!r} needs a header line in {name} "
+                             "naming its columns, time first (e.g. t,ax,ay,az); found none")
+                return None
+            if column not in header[1:]:
+                hint = (f"{column!r} is the time column" if column == header[0] else
+                        f"{name} has no column {column!r}{_suggest(column, header[1:])} (its "
+                        f"columns: {', '.join(header)}; time is the first)")
+                self.problem(column_where, hint)
+                return None
+            index = header.index(column)
+        expect = "two numbers 'time,value'" if width == 2 else f"{width} numbers per row"
+        rows = []
+        for lineno, cells in lines:
+            if len(cells) != width or not all(_is_float(c) for c in cells):
+                found = (f"{len(cells)} field(s)" if len(cells) != width
+                         else "a field that is not a number")
+                self.problem(where, f"{_short(name)}, line {lineno}: expected {expect}, found "
+                             f"{found}")
+                return None
+            pair = (float(cells[0]), float(cells[index]))
+            if not all(math.isfinite(float(c)) for c in cells):
+                self.problem(where, f"{_short(name)}, line {lineno}: expected finite numbers, "
+                             "found inf or nan")
+                return None
+            rows.append(pair)
+        return rows
+
+
+def _finite(tf: TimeFunction) -> bool:
+    """f, f' and f'' finite, and with finite squares (below 1e150: energies and norms square
+    them), where they are largest: at 0, the breakpoints, inside a ramp (f'' peaks at x = 0.21
+    and 0.79), at a quarter period, at a table's points and between."""
+    ts = [0.0, *tf.breakpoints()]
+    if isinstance(tf, Ramp):
+        ts += [tf.start + tf.duration * x for x in (0.2113, 0.5, 0.7887)]
+    elif isinstance(tf, Sine | Cosine):
+        ts += [0.25 / tf.frequency, 0.5 / tf.frequency]
+    elif isinstance(tf, Table):
+        t = np.asarray(tf.t)
+        ts += [*t, *(0.5 * (t[1:] + t[:-1]))]
+    with np.errstate(all="ignore"):
+        values = tf.evaluate(np.asarray(ts, float))
+    return all((np.isfinite(v) & (np.abs(v) < 1e150)).all() for v in values)
+
+
+def _is_float(cell: str) -> bool:
+    """Whether a CSV cell reads as a number (inf and nan included: reported as not finite)."""
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
