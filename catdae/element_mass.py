@@ -298,6 +298,13 @@ def _mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, 
 
 
 @njit(cache=True)
+def _dynamics_work():
+    """Work arrays of ``_dynamics_one``: x, g6, fg, dkk, gm, bm, fm, nm, dn."""
+    return (np.empty(3), np.empty(6), np.empty((6, 3)), np.empty((3, 3, 3)), np.empty((3, 3)),
+            np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 6)), np.empty((3, 6)))
+
+
+@njit(cache=True)
 def _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
                   pmptr, pms, pmm, want_m, want_c, want_dm, fflat, kmat, its, stat, mout, cout,
                   dout, x, g6, fg, dkk, gm, bm, fm, nm, dn):
@@ -340,15 +347,7 @@ def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, 
     M_e = Σ_g m L0 w_g N(s_g)ᵀ N(s_g) + Σ_p m_p N(s_p)ᵀ N(s_p); C_e the same with c for m
     (point masses carry no material damping). Point masses inside elements: CSR ``pmptr``.
     """
-    x = np.empty(3)
-    g6 = np.empty(6)
-    fg = np.empty((6, 3))
-    dkk = np.empty((3, 3, 3))
-    gm = np.empty((3, 3))
-    bm = np.empty((3, 3))
-    fm = np.empty((3, 3))
-    nm = np.empty((3, 6))
-    dn = np.empty((3, 6))
+    x, g6, fg, dkk, gm, bm, fm, nm, dn = _dynamics_work()
     for e in range(chord.shape[0]):
         _dynamics_one(e, chord[e], l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq,
                       cq, pmptr, pms, pmm, True, want_c, want_dm, fflat, kmat, its, stat, mout,

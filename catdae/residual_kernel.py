@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from .catenary import NOT_CONVERGED
-from .element_mass import _dynamic_forces, _dynamics_one
+from .element_mass import _dynamic_forces, _dynamics_one, _dynamics_work
 
 
 @njit(cache=True)
@@ -46,15 +46,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         X[d] = xp[k]
         V[d] = vp[k]
         A[d] = ap[k]
-    xw = np.empty(3)
-    g6 = np.empty(6)
-    fg = np.empty((6, 3))
-    dkk = np.empty((3, 3, 3))
-    gm = np.empty((3, 3))
-    bm = np.empty((3, 3))
-    fm = np.empty((3, 3))
-    nm = np.empty((3, 6))
-    dn = np.empty((3, 6))
+    xw, g6, fg, dkk, gm, bm, fm, nm, dn = _dynamics_work()
     chord = np.empty(3)
     ne = conn.shape[0]
     for e in range(ne):
