@@ -7,11 +7,8 @@ made by ``speed_accuracy.py --ref-cache FILE`` (benchmarks/speed_accuracy.md §7
 """
 import argparse
 import os
-import resource
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -19,31 +16,6 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import speed_accuracy as sa  # noqa: E402
-
-import catdae  # noqa: E402
-
-
-def whole(n: int, rtol: float, order: str, folder: Path, zref: np.ndarray):
-    text = sa.case_text(n, rtol)
-    if order != "auto":
-        text = text.replace('mass_model = "blended"',
-                            f'mass_model = "blended"\nmax_order = {int(order)}')
-    path = folder / f"case_{n}_{rtol:g}_{order}.toml"
-    path.write_text(text)
-    out = folder / f"out_{n}.nc"
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run([sys.executable, "-m", "catdae", "run", str(path), "-o", str(out),
-                        "--no-progress"], capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode != 0:
-        raise RuntimeError(p.stderr[-2000:])
-    ds = catdae.read_results(out)["motion"].ds
-    z = ds.position.sel(node=f"c.{n // 2}", axis="z").values
-    out.unlink()
-    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
-    return wall, cpu, sa.err(z, zref), int(ds.attrs["n_steps"])
 
 
 def main() -> None:
@@ -59,7 +31,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for spec in args.catdae:
             n, rtol, order = spec.split(":")
-            w, c, e, st = whole(int(n), float(rtol), order, Path(tmp), zref)
+            r = sa.whole_catdae(int(n), float(rtol), Path(tmp), max_order=order)
+            w, c, e, st = r["wall"], r["cpu"], sa.err(r["z"], zref), r["steps"]
             print(f"catdae {n} elements rtol {float(rtol):g} max_order {order}: err {e:.2e} m, "
                   f"{st} steps, wall {w:.2f} s, CPU {c:.2f} s, load {os.getloadavg()[0]:.1f}",
                   flush=True)

@@ -93,9 +93,14 @@ mass_model = "{mass_model}"
 """
 
 
-def case_text(n: int, rtol: float, mass_model: str = "blended", duration: float = DURATION):
-    return CASE.format(mass=100.0 / 9.81, elements=n, duration=duration, rtol=rtol,
+def case_text(n: int, rtol: float, mass_model: str = "blended", duration: float = DURATION,
+              max_order: str | int = "auto"):
+    text = CASE.format(mass=100.0 / 9.81, elements=n, duration=duration, rtol=rtol,
                        atol=rtol * 1e-2, mass_model=mass_model)
+    if max_order != "auto":
+        text = text.replace(f'mass_model = "{mass_model}"',
+                            f'mass_model = "{mass_model}"\nmax_order = {int(max_order)}')
+    return text
 
 
 def run_catdae(n: int, rtol: float, **kw) -> dict:
@@ -108,10 +113,11 @@ def run_catdae(n: int, rtol: float, **kw) -> dict:
             "step_wall": float(ds.attrs["wall_time"])}
 
 
-def whole_catdae(n: int, rtol: float, folder: Path) -> dict:
-    """``python -m catdae run`` in a new process: wall and CPU time of the whole process."""
-    path = folder / f"case_{n}_{rtol:g}.toml"
-    path.write_text(case_text(n, rtol))
+def whole_catdae(n: int, rtol: float, folder: Path, max_order: str | int = "auto") -> dict:
+    """``python -m catdae run`` in a new process: wall and CPU time of the whole process, and
+    the run's midspan z history and step count (read back from its results file)."""
+    path = folder / f"case_{n}_{rtol:g}_{max_order}.toml"
+    path.write_text(case_text(n, rtol, max_order=max_order))
     out = folder / f"out_{n}_{rtol:g}_{time.time_ns()}.nc"
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
@@ -121,8 +127,12 @@ def whole_catdae(n: int, rtol: float, folder: Path) -> dict:
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
         raise RuntimeError(p.stderr[-2000:])
+    ds = catdae.read_results(out)["motion"].ds
+    z = ds.position.sel(node=f"c.{n // 2}", axis="z").values
+    steps = int(ds.attrs["n_steps"])
     out.unlink(missing_ok=True)
-    return {"wall": wall, "cpu": (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)}
+    return {"wall": wall, "cpu": (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime),
+            "z": z, "steps": steps}
 
 
 def ops_job(n: int) -> dict:
