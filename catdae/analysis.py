@@ -12,9 +12,9 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from . import formfind, results
+from ._xr import xr
 from .assembly import Model
 from .case import Case, Step, load_case
 from .element import NOT_CONVERGED

@@ -20,8 +20,8 @@ from xml.sax.saxutils import quoteattr
 
 import meshio
 import numpy as np
-import xarray as xr
 
+from ._xr import xr
 from .errors import CatdaeError
 
 

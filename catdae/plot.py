@@ -22,9 +22,9 @@ import os
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 from matplotlib.figure import Figure
 
+from ._xr import xr
 from .errors import CatdaeError
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes")

@@ -15,9 +15,9 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from . import __version__
+from ._xr import xr
 from .mesh import AXES, Mesh
 
 CONVENTIONS = "CF-1.10"

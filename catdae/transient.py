@@ -19,9 +19,9 @@ import warnings
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
-import xarray as xr
 from sksundae.ida import IDA
 
+from ._xr import xr
 from .assembly import Model
 from .errors import SolverError
 from .progress import reporter

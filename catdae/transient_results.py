@@ -4,9 +4,9 @@ dataset, and the run's own advice on its accuracy (docs/theory.md §8, §10)."""
 from __future__ import annotations
 
 import numpy as np
-import xarray as xr
 
 from . import results
+from ._xr import xr
 from .assembly import Model
 from .element import ElementState
 

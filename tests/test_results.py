@@ -287,3 +287,39 @@ def test_every_group_passes_the_cf_checker(written, tmp_path):
         assert score > 0.95, (name, score)
     failed, _ = _cf_high_priority_failures(path, "cf:1.8")  # the root group of the file
     assert failed == []
+
+
+_DASK_PROBE = r"""
+import sys
+import numpy as np
+import catdae
+tree = catdae.run(sys.argv[1], progress=False)
+from catdae.results import write_tree
+write_tree(tree, sys.argv[2])
+back = catdae.read_results(sys.argv[2])
+assert "dask.array" not in sys.modules, "a run imported dask.array"
+import dask.array as da
+from catdae._xr import xr
+lazy = xr.DataArray(da.ones(4, chunks=2), dims="x")
+assert lazy.chunks == ((2, 2),), lazy.chunks
+masked = da.ma.masked_array(np.arange(4.0), mask=[0, 1, 0, 0], chunks=2)
+v = xr.Variable("x", masked).values
+assert np.isnan(v[1]) and v[3] == 3.0, v
+print("ok", float(back["tapped"].ds.time[-1]))
+"""
+
+
+def test_a_run_does_not_import_dask_and_dask_arrays_still_work(tmp_path):
+    """xarray imports dask.array (0.7 s) on the first Variable it builds whenever dask is
+    installed; catdae answers xarray's question without the import (catdae/_xr.py). Checked in
+    a fresh process: a whole run, its netCDF write and read leave dask.array unimported, and
+    after it dask arrays are still dask arrays to xarray, masked ones still masked."""
+    import subprocess
+    import sys
+
+    case = tmp_path / "case.toml"
+    case.write_text(CASE)
+    proc = subprocess.run([sys.executable, "-c", _DASK_PROBE, str(case), str(tmp_path / "o.nc")],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.startswith("ok")

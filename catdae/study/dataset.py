@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import xarray as xr
 
+from .._xr import xr
 from ..case import Step
 from .core import _CHOICES, _COORD_META, _COUNTS, _MEMORY_NAMES
 

@@ -9,8 +9,8 @@ import os
 from collections.abc import Iterator
 
 import numpy as np
-import xarray as xr
 
+from .._xr import xr
 from .core import SETTINGS
 
 

@@ -6,8 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import xarray as xr
-
+from .._xr import xr
 from ..results import write_atomic
 from .core import SETTINGS
 from .plots import plot_convergence, plot_work_precision

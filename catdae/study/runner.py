@@ -13,9 +13,8 @@ from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
 
-import xarray as xr
-
 from .. import __version__
+from .._xr import xr
 from ..analysis import as_case
 from ..case import AXES, Case, Step
 from ..errors import CaseError

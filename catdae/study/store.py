@@ -8,8 +8,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
+from .._xr import xr
 from ..results import write_atomic
 from .core import STORE_FORMAT
 

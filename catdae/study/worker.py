@@ -8,8 +8,7 @@ import sys
 import time
 from dataclasses import replace
 
-import xarray as xr
-
+from .._xr import xr
 from ..analysis import run
 from ..case import AXES, Case, Step
 from ..errors import CatdaeError

@@ -1,0 +1,70 @@
+"""xarray, imported once for catdae, without its 0.7 s probe of dask.
+
+xarray asks, for every Variable it builds from data, whether the data is a dask array; the
+first time, it answers by importing ``dask.array`` whenever dask is installed (catdae installs
+it for studies). On this project's 2-core machines that import was 0.7 s of every ``catdae
+run`` (benchmarks/speed_accuracy.md §8), although no catdae result holds a dask array.
+
+The answer needs no import: an object can only be a ``dask.array.Array`` if ``dask.array`` has
+been imported. ``_LazyDask`` gives xarray exactly that answer: the real array type once
+``dask.array`` is in ``sys.modules`` (imported by the user, by a study, by xarray's own
+chunking), and no type before. Everything else xarray may ask of it (the module, its version,
+whether it is available) imports dask and answers as xarray would. It is put in xarray's
+private cache of duck-array modules only if that cache is as expected and empty for dask;
+otherwise nothing changes (and the probe costs its 0.7 s again).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import xarray as xr
+
+__all__ = ["xr"]
+
+
+class _LazyDask:
+    """xarray's DuckArrayModule("dask"), answering ``type`` without importing dask."""
+
+    def __init__(self, real_class):
+        self._real_class = real_class
+        self._real = None
+
+    def _load(self):
+        if self._real is None:
+            self._real = self._real_class("dask")
+        return self._real
+
+    @property
+    def type(self):
+        if "dask.array" in sys.modules:
+            return self._load().type
+        return ()
+
+    @property
+    def module(self):
+        return self._load().module
+
+    @property
+    def version(self):
+        return self._load().version
+
+    @property
+    def available(self):
+        return self._load().available
+
+
+def _install() -> bool:
+    try:
+        from xarray.namedarray import pycompat
+    except ImportError:  # pragma: no cover - another xarray layout: keep its own probe
+        return False
+    cache = getattr(pycompat, "_cached_duck_array_modules", None)
+    real = getattr(pycompat, "DuckArrayModule", None)
+    if not isinstance(cache, dict) or real is None or "dask" in cache:
+        return False
+    cache["dask"] = _LazyDask(real)
+    return True
+
+
+INSTALLED = _install()
