@@ -393,6 +393,43 @@ def _partial_batch(h, l0, ea, w, ptr, ls, lf, s, xout, gout, want_flex):
 
 
 @njit(cache=True)
+def _energy_batch(h, l0, ea, w, ptr, ls, lf, xi, wi, out):
+    """Per element, out[e, 0]: strain energy ∫ T²/(2 EA) ds, exact (T² is a quadratic in s
+    between the loads); out[e, 1]: ∫ w (z(s) - z_i) ds by the Gauss points xi, wi (on [-1, 1])
+    on each smooth piece between the loads."""
+    d = np.empty(3)
+    f = np.empty(6)
+    for e in range(h.shape[0]):
+        hx, hy, v = h[e, 0], h[e, 1], h[e, 2]
+        we = w[e]
+        a = 0.0
+        acc = 0.0
+        for k in range(ptr[e], ptr[e + 1] + 1):
+            b = l0[e] if k == ptr[e + 1] else min(max(ls[k], a), l0[e])
+            if b > a:  # ∫_a^b hx² + hy² + (v + w s)² ds
+                acc += ((hx * hx + hy * hy + v * v) * (b - a) + v * we * (b * b - a * a)
+                        + we * we * (b * b * b - a * a * a) / 3.0)
+                a = b
+            if k < ptr[e + 1]:
+                hx -= lf[k, 0]
+                hy -= lf[k, 1]
+                v -= lf[k, 2]
+        out[e, 0] = acc / (2.0 * ea[e])
+        g = 0.0
+        a = 0.0
+        for k in range(ptr[e], ptr[e + 1] + 1):  # Gauss on each smooth piece between loads
+            b = l0[e] if k == ptr[e + 1] else min(max(ls[k], a), l0[e])
+            if b > a and we != 0.0:
+                for j in range(xi.shape[0]):
+                    sj = a + 0.5 * (xi[j] + 1.0) * (b - a)
+                    _partial(h[e, 0], h[e, 1], h[e, 2], we, ea[e], sj, ls, lf, ptr[e],
+                             ptr[e + 1], d, f, False)
+                    g += 0.5 * wi[j] * (b - a) * we * d[2]
+                a = b
+        out[e, 1] = g
+
+
+@njit(cache=True)
 def _tension_batch(h, w, ptr, ls, lf, s, tout):
     """Tension vector t(s) (n, q, 3); loads at s_k act for s > s_k."""
     for e in range(h.shape[0]):

@@ -16,6 +16,7 @@ from .catenary import (  # noqa: F401  (re-exported)
     NOT_CONVERGED,
     SLACK,
     STATUS_NAMES,
+    _energy_batch,
     _partial_batch,
     _solve_batch,
     _tension_batch,
@@ -283,9 +284,21 @@ class Elements:
 
     def end_tensions(self, h) -> np.ndarray:
         """Tension at s = 0 and s = L0 (just inside the element), (n, 2) N."""
-        t_i = np.linalg.norm(self._h(h), axis=-1)
-        t_j = np.linalg.norm(self.end_forces(h)[:, 1], axis=-1)
-        return np.stack([t_i, t_j], axis=1)
+        h = self._h(h)
+        hj = h - self._load_total  # the end force at j, r_j of end_forces
+        hj[:, 2] += self.w * self.L0
+        out = np.empty((self.n, 2))
+        out[:, 0] = np.sqrt(np.einsum("ij,ij->i", h, h))
+        out[:, 1] = np.sqrt(np.einsum("ij,ij->i", hj, hj))
+        return out
+
+    def energies(self, h, xi, wi) -> np.ndarray:
+        """Per element (n, 2): the strain energy ∫ T²/(2 EA) ds (exact) and ∫ w (z(s) - z_i) ds
+        (Gauss points xi, weights wi on [-1, 1], on each piece between loads), J."""
+        out = np.empty((self.n, 2))
+        _energy_batch(self._h(h), self.L0, self.EA, self.w, self._ptr, self._ls, self._lf,
+                      np.ascontiguousarray(xi, float), np.ascontiguousarray(wi, float), out)
+        return out
 
     def end_forces(self, h) -> np.ndarray:
         """Resisting forces r_i = -h, r_j = h - Σ f_k + (0, 0, w L0), (n, 2, 3) N (§4).

@@ -426,7 +426,7 @@ class TransientProblem:
         if not self.evaluate(t, y, yp, self._res_scratch):
             raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
                               termination="element failure")
-        state = self._conf_from_buffers()[0]
+        h = self.h  # a copy of the buffer, made by evaluate
         X, V, A = self._Xb.copy(), self._Vb.copy(), self._Ab.copy()
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         f = self._force + self.m_diag * A + self._v_diag * V - p  # M A + C V + g + F - P
@@ -436,7 +436,7 @@ class TransientProblem:
         if self._use_m:
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
-        strain, gravity = potential(m, X.reshape(-1, 3), state, t)
-        return (X, V, A, m.tensions(state), reaction.reshape(-1, 3),
+        strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
 

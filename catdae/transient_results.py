@@ -8,7 +8,6 @@ import numpy as np
 from . import results
 from ._xr import xr
 from .assembly import Model
-from .element import ElementState
 
 _GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
 
@@ -48,18 +47,14 @@ class Outputs:
                                           energy, attrs)
 
 
-def potential(model: Model, X: np.ndarray, state: ElementState, t: float):
+def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
     """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J (loads with a
     time function have no potential: their work changes the total energy)."""
     mesh = model.mesh
     el = model.elements
-    xi, wi = _GAUSS8
-    s = 0.5 * (xi + 1.0)[None, :] * mesh.L0[:, None]  # (n_elem, 8)
-    wq = 0.5 * wi[None, :] * mesh.L0[:, None]
-    tens = el.tension(state.h, s)  # (n_elem, 8)
-    strain = float(np.sum(wq * tens**2 / (2.0 * mesh.EA[:, None])))
-    z = X[mesh.conn[:, 0], 2][:, None] + el.position(state.h, s)[..., 2]
-    gravity = float(np.sum(wq * mesh.w[:, None] * z))
+    per_element = el.energies(h, *_GAUSS8)  # strain (exact), ∫ w (z - z_i) ds
+    strain = float(per_element[:, 0].sum())
+    gravity = float(per_element[:, 1].sum() + mesh.w @ (mesh.L0 * X[mesh.conn[:, 0], 2]))
     # loads inside elements (point-mass weights, constant loads) and at nodes
     ld = model.loading
     if ld.internal_s.size:
@@ -68,7 +63,7 @@ def potential(model: Model, X: np.ndarray, state: ElementState, t: float):
         sq = np.zeros((mesh.n_elements, max(int(counts.max()), 1)))
         slot = np.arange(ld.internal_s.size) - ld.internal_ptr[e_of]
         sq[e_of, slot] = ld.internal_s
-        xk = X[mesh.conn[:, 0]][:, None, :] + el.position(state.h, sq)
+        xk = X[mesh.conn[:, 0]][:, None, :] + el.position(h, sq)
         gravity -= float(np.sum(ld.internal_force * xk[e_of, slot]))
     # only the constant loads have a potential; the work of loads that vary in time (like that
     # of moving supports) changes the total energy instead

@@ -861,3 +861,31 @@ def test_mass_gradient_against_re_solved_finite_differences():
     scale = np.abs(ref).reshape(n, -1).max(axis=1)
     err = np.abs(dm - ref).reshape(n, -1).max(axis=1) / scale
     assert np.median(err) < 1e-9 and err.max() < 1e-7, (np.median(err), err.max())
+
+
+def test_energy_integrals_with_loads_inside_equal_adaptive_quadrature():
+    """``Elements.energies``: ∫ T²/(2 EA) ds (in closed form, T² being quadratic in s between
+    loads) and ∫ w (z(s) - z_i) ds (Gauss on each smooth piece) against scipy's adaptive
+    quadrature of the element's own tension and position, breaking at the loads."""
+    from scipy.integrate import quad
+
+    from catdae.element import Elements, PointLoads
+
+    L0, EA, w = [10.0, 12.0, 8.0], [1e6, 2e6, 5e5], [50.0, 30.0, 0.0]
+    loads = PointLoads.from_lists([[(7.0, (0.0, 20.0, -100.0)), (3.0, (10.0, -5.0, 200.0))], [],
+                                   [(4.0, (1.0, 2.0, 3.0))]])
+    el = Elements(L0, EA, w, loads)
+    h = np.array([[1000.0, 50.0, -300.0], [2000.0, -10.0, -100.0], [500.0, 0.0, -10.0]])
+    out = el.energies(h, *np.polynomial.legendre.leggauss(8))
+    breaks = [[3.0, 7.0], [], [4.0]]
+    for e in range(3):
+        def at(s, e=e):
+            return np.full((3, 1), s)
+
+        strain = quad(lambda s, e=e: float(el.tension(h, at(s))[e, 0]) ** 2 / (2 * EA[e]), 0,
+                      L0[e], points=breaks[e] or None, limit=200, epsabs=0, epsrel=1e-12)[0]
+        grav = quad(lambda s, e=e: w[e] * float(el.position(h, at(s))[e, 0, 2]), 0, L0[e],
+                    points=breaks[e] or None, limit=200, epsabs=1e-12, epsrel=1e-12)[0]
+        assert out[e, 0] == pytest.approx(strain, rel=1e-12)
+        assert out[e, 1] == pytest.approx(grav, rel=1e-11, abs=1e-9)
+    assert out[1, 0] > 0 and out[0, 1] < 0  # not trivially zero
