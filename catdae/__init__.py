@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
+from ._kernel_cache import purge_stale as _purge_stale
 from .errors import (
     CaseError,
     CatdaeError,
@@ -17,6 +18,9 @@ try:
     __version__ = version("catdae")
 except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
     __version__ = "0.0.0+unknown"
+
+# numba's cache follows each kernel's own file only: drop cached kernels whose callees changed
+_purge_stale()
 
 
 
