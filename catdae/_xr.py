@@ -1,9 +1,11 @@
-"""xarray, imported once for catdae, without its 0.7 s probe of dask.
+"""xarray, imported once for catdae, without its probe of dask.array.
 
 xarray asks, for every Variable it builds from data, whether the data is a dask array; the
 first time, it answers by importing ``dask.array`` whenever dask is installed (catdae installs
-it for studies). On this project's 2-core machines that import was 0.7 s of every ``catdae
-run`` (benchmarks/speed_accuracy.md §8), although no catdae result holds a dask array.
+it for studies), although no catdae result holds a dask array. On this project's 2-core
+machines that import was about 0.3 s of CPU in every ``catdae run`` (``python
+benchmarks/startup.py``, benchmarks/speed_accuracy.md §8). xarray still imports ``dask.base``
+(another 0.3 s) to ask whether an index is a dask collection; that is left to it.
 
 The answer needs no import: an object can only be a ``dask.array.Array`` if ``dask.array`` has
 been imported. ``_LazyDask`` gives xarray exactly that answer: the real array type once
