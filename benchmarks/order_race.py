@@ -164,7 +164,7 @@ def cmd_table(args) -> None:
             base.update(case=case, step=step)
             label = f"| {case.removesuffix('.toml')} {n or ''} | | "
 
-        def get(d, order):
+        def get(d, order, base=base):
             k = key(dict(base, order=order))
             return d.get(k), k
         ab, kab = get(before, "auto")
