@@ -66,6 +66,10 @@ def jobs(which: str) -> list[dict]:
                            ("example2_support_motion_violent.toml", "excitation")):
             for order in orders:
                 out.append(dict(kind="case", case=name, step=step, n=None, order=order))
+    elif which == "gentle-5":  # the displacement of fixed order 5 (for nothing_lost.md)
+        for n in (10, 50):
+            out.append(dict(kind="case", case="example2_support_motion_gentle.toml",
+                            step="excitation", n=n, order=5))
     elif which == "gentle100":
         for order in ("auto", 5):
             out.append(dict(kind="case", case="example2_support_motion_gentle.toml",
@@ -139,54 +143,68 @@ def load(path: str) -> tuple[dict, dict]:
 
 
 def cmd_table(args) -> None:
+    """Markdown tables: issue 11's cable (error in mm against the reference), then the cases."""
     recs, zs = load(args.out)
     before, zb = load(args.before) if args.before else ({}, {})
     zref = np.load(args.ref)["z"] if args.ref else None
+    zall = {**zb, **zs}
 
-    def error(k, zz):
-        if zref is None or k not in zz:
-            return ""
-        z = zz[k]
-        return f"{sa.err(z, zref[:len(z)]) * 1e3:.2f}"
-
-    def cell(r, k, zz):
+    def cell(d, job, err=True):
+        k = key(job)
+        r = d.get(k)
         if r is None:
-            return "", "", "", ""
-        return (f"{r['cpu']:.2f}", f"{r['steps']}", error(k, zz), f"{r['nres'] / r['steps']:.2f}")
+            return ""
+        text = f"{r['cpu']:.2f} / {r['steps']}"
+        zz = zb if d is before else zs if d is recs else zall
+        if err and zref is not None and k in zz:
+            z = zz[k]
+            text += f" / {sa.err(z, zref[:len(z)]) * 1e3:.2f}"
+        return text + (f" / {r['order']}" if job["order"] == "auto" else "")
 
-    print("| n | rtol | T s | auto before: CPU s / steps / err mm | auto after: CPU s / steps / "
-          "err mm / order | fixed 2: CPU / steps / err | fixed 5: CPU / steps / err | "
-          "after's choice |")
+    both = {**before, **recs}
+    print("| n | rtol | T s | auto before | auto after | fixed 2 | fixed 5 | races after |")
     print("|---:|---:|---:|---|---|---|---|---|")
-    rows = sorted({(r["job"]["kind"], str(r["job"].get("case", "")), r["job"]["n"] or 0,
-                    -r["job"].get("rtol", 0), r["job"].get("duration", 0),
-                    r["job"].get("step", "")) for r in list(recs.values()) + list(before.values())})
-    for kind, case, n, mrtol, dur, step in rows:
-        base = dict(kind=kind, n=n or None)
-        if kind == "issue11":
-            base.update(rtol=-mrtol, duration=dur)
-            label = f"| {n} | {-mrtol:g} | {dur:g} "
-        else:
-            base.update(case=case, step=step)
-            label = f"| {case.removesuffix('.toml')} {n or ''} | | "
-
-        def get(d, order, base=base):
-            k = key(dict(base, order=order))
-            return d.get(k), k
-        ab, kab = get(before, "auto")
-        aa, kaa = get(recs, "auto")
-        f2, k2 = get(recs, 2)
-        if f2 is None:
-            f2, k2 = get(before, 2)
-        f5, k5 = get(recs, 5)
-        if f5 is None:
-            f5, k5 = get(before, 5)
-        zall = {**zb, **zs}
-        c_ab = " / ".join(cell(ab, kab, zb)[:3]) + (f" / {ab['order']}" if ab else "")
-        c_aa = " / ".join(cell(aa, kaa, zs)[:3]) + (f" / {aa['order']}" if aa else "")
-        c2 = " / ".join(cell(f2, k2, zall)[:3])
-        c5 = " / ".join(cell(f5, k5, zall)[:3])
-        print(f"{label}| {c_ab} | {c_aa} | {c2} | {c5} | {aa['choice'] if aa else ''} |")
+    cable = sorted({(r["job"]["n"], -r["job"]["rtol"], r["job"]["duration"])
+                    for r in both.values() if r["job"]["kind"] == "issue11"})
+    notes = []
+    for n, mrtol, dur in cable:
+        base = dict(kind="issue11", n=n, rtol=-mrtol, duration=dur)
+        aa = recs.get(key(dict(base, order="auto")))
+        races = aa["choice"].count("race(s), chosen") and aa["choice"].split(
+            "race(s), chosen")[0].split(";")[-1].strip() if aa else ""
+        print(f"| {n} | {-mrtol:g} | {dur:g} | {cell(before, dict(base, order='auto'))} | "
+              f"{cell(recs, dict(base, order='auto'))} | {cell(both, dict(base, order=2))} | "
+              f"{cell(both, dict(base, order=5))} | {races or 0} |")
+        if aa:
+            notes.append(f"{n} el, rtol {-mrtol:g}, {dur:g} s: {aa['choice']}")
+    print()
+    print("| case | elements | auto before | auto after | fixed 2 | fixed 5 |"
+          " residuals per step at 2 / 5 |")
+    print("|---|---:|---|---|---|---|---|")
+    cases = sorted({(r["job"]["case"], r["job"]["step"], r["job"]["n"] or 0)
+                    for r in both.values() if r["job"]["kind"] == "case"})
+    for case, step, n in cases:
+        base = dict(kind="case", case=case, step=step, n=n or None)
+        per = []
+        for order in (2, 5):
+            r = both.get(key(dict(base, order=order)))
+            per.append(f"{r['nres'] / r['steps']:.2f}" if r else "")
+        print(f"| {case.removesuffix('.toml')} | {n or 'as bundled'} | "
+              + " | ".join(cell(d, dict(base, order=o), err=False)
+                           for d, o in ((before, "auto"), (recs, "auto"), (both, 2),
+                                        (both, 5)))
+              + f" | {' / '.join(per)} |")
+        aa = recs.get(key(dict(base, order="auto")))
+        if aa:
+            notes.append(f"{case} {n or ''}: {aa['choice']}")
+        ka, k5 = key(dict(base, order="auto")), key(dict(base, order=5))
+        if ka in zs and k5 in zall:
+            d = np.abs(zs[ka] - zall[k5]).max(axis=0)
+            notes.append(f"  midspan |auto - fixed 5|, y, z: {d[1] * 1e3:.3f}, "
+                         f"{d[2] * 1e3:.3f} mm")
+    print()
+    for line in notes:
+        print("- " + line)
 
 
 def main(argv=None) -> None:

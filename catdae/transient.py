@@ -248,6 +248,7 @@ class OrderChoice:
     START_RATIO = 100.0  # ω_max / ω₁ above which the run starts at order 2
     MIN_REMAINING = 8  # no race when fewer than this many trial windows of steps are left
     LONG2 = 3  # an order-2 window is this many windows long (it first damps what order 5 left)
+    FIRST_TIME = 0.1  # a first window at order 2 lasts at least this share of 2π/ω₁
 
     def __init__(self, omega_max: float | None, omega_1: float, t_end: float = np.inf):
         self.t_end = t_end
@@ -268,6 +269,7 @@ class OrderChoice:
         self.skipped = 0  # races not run because order 5 cannot win
         self.short = 0  # races not run because too little of the step was left
         self.since = None  # time the current order was chosen
+        self.t_first = None  # time of the first step
         self.note = ("no highest frequency: order 5 kept" if omega_max is None else "")
 
     def restart(self) -> None:
@@ -288,12 +290,19 @@ class OrderChoice:
     def observe(self, t: float) -> int | None:
         """Called after every step at time t; returns the new order cap when it changes."""
         self.count += 1
+        if self.t_first is None:
+            self.t_first = t
         half = self.WINDOW // 2
         if self.count == self.length - half:
             self.t_mark = t
         if self.count < self.length or self.t_mark is None or t <= self.t_mark:
             if self.count >= self.length:  # interrupted by restarts: measure a new half
                 self.count = self.length - half - 1
+            return None
+        if (self.mode == "first" and self.order == 2
+                and t - self.t_first < self.FIRST_TIME * 2.0 * np.pi / self.omega_1):
+            self.count = self.length - half - 1  # order 2 is still damping what the start
+            self.t_mark = None  # excited: measure a later half-window
             return None
         self.rate[self.order] = half / (t - self.t_mark)
         self.count = 0
