@@ -249,7 +249,8 @@ class OrderChoice:
     START_RATIO = 100.0  # ω_max / ω₁ above which the run starts at order 2
     MIN_REMAINING = 8  # no race when fewer than this many trial windows of steps are left
     LONG2 = 3  # an order-2 window is this many windows long (it first damps what order 5 left)
-    FIRST_TIME = 0.1  # a first window at order 2 lasts at least this share of 2π/ω₁
+    FIRST_TIME = 0.1  # a first window at order 2 lasts at least this share of 2π/ω₁ ...
+    FIRST_MAX = 16  # ... or this many windows of steps, whichever comes first
 
     def __init__(self, omega_max: float | None, omega_1: float, t_end: float = np.inf):
         self.t_end = t_end
@@ -271,6 +272,7 @@ class OrderChoice:
         self.short = 0  # races not run because too little of the step was left
         self.since = None  # time the current order was chosen
         self.t_first = None  # time of the first step
+        self.n_first = 0  # steps of the first window
         self.note = ("no highest frequency: order 5 kept" if omega_max is None else "")
 
     def restart(self) -> None:
@@ -291,6 +293,7 @@ class OrderChoice:
     def observe(self, t: float) -> int | None:
         """Called after every step at time t; returns the new order cap when it changes."""
         self.count += 1
+        self.n_first += self.mode == "first"
         if self.t_first is None:
             self.t_first = t
         half = self.WINDOW // 2
@@ -301,7 +304,8 @@ class OrderChoice:
                 self.count = self.length - half - 1
             return None
         if (self.mode == "first" and self.order == 2
-                and t - self.t_first < self.FIRST_TIME * 2.0 * np.pi / self.omega_1):
+                and t - self.t_first < self.FIRST_TIME * 2.0 * np.pi / self.omega_1
+                and self.n_first < self.FIRST_MAX * self.WINDOW):
             self.count = self.length - half - 1  # order 2 is still damping what the start
             self.t_mark = None  # excited: measure a later half-window
             return None
