@@ -234,8 +234,9 @@ class OrderChoice:
     content (about 350 steps on issue 11's cable at 48 elements) before its own rate shows, and
     a first window at order 2 lasts ``FIRST_TIME`` times the lowest period 2π/ω₁ (the start of
     a motion excites that content too), or ``FIRST_MAX`` windows if that comes first. The race
-    is run again after ``FIRST_INTERVAL`` windows at the chosen order, the interval doubling each time the choice is kept and starting again when it changes, so that a change
-    of regime is followed at a cost that shrinks with the run. No race is run with fewer than
+    is run again after ``FIRST_INTERVAL`` windows at the chosen order, the interval doubling
+    each time the choice is kept and starting again when it changes, so that a change of
+    regime is followed at a cost that shrinks with the run. No race is run with fewer than
     ``MIN_REMAINING`` trial windows of steps left (the trial could cost more than it saves), and
     order 5 is not tried where it cannot win: its steady steps have h ω_max < ``STABILITY_HW``
     (measured 0.2-0.8 undamped, 3.3 with example 1's damping), so it takes at least
