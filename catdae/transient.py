@@ -6,9 +6,9 @@ solver, the tolerances and the BDF order cap, steps IDA one internal step at a t
 and restarting at the kinks and jumps of prescribed motions and loads), records the output times
 (``transient_results.Outputs``) and keeps what was computed when a run fails or is interrupted.
 
-BDF order (``max_order = "auto"``, the default): OrderChoice measures whether order 5 is held
-down by the stability of the mesh's fast modes and then goes on at order 2 (docs/theory.md
-§8.6).
+BDF order (``max_order = "auto"``, the default): OrderChoice races orders 5 and 2, a window of
+steps each from the same state, and goes on with the one that takes fewer steps per simulated
+second, racing again now and then (docs/theory.md §8.6).
 """
 
 from __future__ import annotations
@@ -69,9 +69,10 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     atol[0::2] = step.atol
     atol[1::2] = step.atol * omega
     auto = step.max_order == "auto"
-    order_choice = (OrderChoice(_highest_frequency(prob, t0, y0), omega, float(step.rtol))
+    order_choice = (OrderChoice(_highest_frequency(prob, t0, y0), omega, t_end)
                     if auto else None)
-    options = dict(rtol=step.rtol, atol=atol, max_order=5 if auto else int(step.max_order),
+    options = dict(rtol=step.rtol, atol=atol,
+                   max_order=order_choice.order if auto else int(step.max_order),
                    max_num_steps=100000, linsolver=linsolver)
     if linsolver == "band":
         bw = prob.bandwidth
@@ -176,6 +177,8 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
                 i_stop += 1
                 if i_stop < len(stops):
                     solver.init_step(t_stop, y_last, yp_last)
+                    if order_choice is not None:
+                        order_choice.restart()
                 while (k_done < times.size
                        and abs(times[k_done] - t_int) <= 1e-13 * max(abs(t_int), 1.0)):
                     record(k_done, times[k_done], y_last, yp_last)
@@ -215,68 +218,157 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
 
 
 class OrderChoice:
-    """The BDF order cap of ``max_order = "auto"``, chosen by measurement during the run.
+    """The BDF order cap of ``max_order = "auto"``: a race between orders 2 and 5, measured.
 
     BDF orders 3-5 are not stable along the imaginary axis: undamped modes with h ω of order 1
-    (the axial modes of a fine mesh) force their step down, whatever the accuracy needs, and the
-    steps per simulated second then grow with the mesh. BDF2 is A-stable (it damps the modes
-    far above 1/h). The run starts at order 5; after IDA's start-up window of ``WINDOW`` steps
-    the mean step h of each following window decides: order 5 is stability-bound where h ω_max <
-    ``STABILITY_HW``, and it is following the mesh's fast modes rather than the motion where it
-    also takes more than ``STEPS_PER_PERIOD`` steps per period of the lowest mode (2π/ω₁). Then
-    the rest of the step runs at order 2; otherwise order 5 goes on and the next window is
-    tested again. At rtol < ``TIGHT_RTOL`` order 5 stays (docs/theory.md §8.6;
-    measurements in benchmarks/speed_accuracy.md). ``order_choice`` says what was measured.
-    """
+    (the axial modes of a fine mesh) hold their step down whatever the accuracy needs. BDF2 is
+    A-stable and damps them, but is less accurate per step. Which of the two takes fewer steps
+    depends on the mesh, the tolerance and the motion, and changes during a run, so it is
+    measured (docs/theory.md §8.6), in steps per simulated second over the second half of a
+    *window* of steps of one IDA (a new IDA starts at order 1 with short steps). The run starts
+    at order 2 where ω_max / ω₁ > ``START_RATIO`` (it leaves the state free of the fast content
+    that order 5 carries and order 2 must first damp), at order 5 otherwise. After the first
+    window the other order runs one window from the current state (a new IDA) and takes over if
+    it measures fewer than ``MARGIN`` times the incumbent's steps per second. An order-2 window
+    is ``LONG2`` times ``WINDOW`` steps: from a state order 5 left it first damps the axial
+    content (about 350 steps on issue 11's cable at 48 elements) before its own rate shows, and
+    a first window at order 2 lasts ``FIRST_TIME`` times the lowest period 2π/ω₁ (the start of
+    a motion excites that content too), or ``FIRST_MAX`` windows if that comes first. The race
+    is run again after ``FIRST_INTERVAL`` windows at the chosen order, the interval doubling
+    each time the choice is kept and starting again when it changes, so that a change of
+    regime is followed at a cost that shrinks with the run. No race is run with fewer than
+    ``MIN_REMAINING`` trial windows of steps left (the trial could cost more than it saves), and
+    order 5 is not tried where it cannot win: its steady steps have h ω_max < ``STABILITY_HW``
+    (measured 0.2-0.8 undamped, 3.3 with example 1's damping), so it takes at least
+    ω_max / ``STABILITY_HW`` steps per second. Deterministic: the decisions depend on the step
+    counts and the times reached only. ``order_choice`` says what was measured."""
 
-    WINDOW = 150
-    STABILITY_HW = 2.5
-    STEPS_PER_PERIOD = 1.0e4
+    WINDOW = 160  # steps per window; the second half is measured
+    FIRST_INTERVAL = 8  # windows at the chosen order before the next race (doubles when kept)
+    MARGIN = 0.9  # the trial order takes over where it takes fewer than MARGIN x the steps/s
+    STABILITY_HW = 4.0  # order 5's steady h ω_max stays below this (measured <= 3.3)
+    START_RATIO = 100.0  # ω_max / ω₁ above which the run starts at order 2
+    MIN_REMAINING = 8  # no race when fewer than this many trial windows of steps are left
+    LONG2 = 3  # an order-2 window is this many windows long (it first damps what order 5 left)
+    FIRST_TIME = 0.1  # a first window at order 2 lasts at least this share of 2π/ω₁ ...
+    FIRST_MAX = 16  # ... or this many windows of steps, whichever comes first
 
-    TIGHT_RTOL = 1e-6  # below it order 5 is kept: its steps are set by accuracy there
-
-    def __init__(self, omega_max: float | None, omega_1: float, rtol: float):
+    def __init__(self, omega_max: float | None, omega_1: float, t_end: float = np.inf):
+        self.t_end = t_end
         self.omega_max = omega_max
         self.omega_1 = omega_1
-        self.order = 5
-        self.decided = omega_max is None or rtol < self.TIGHT_RTOL
-        self.phase = "start-up"
+        self.decided = omega_max is None  # nothing to measure against: order 5 kept
+        self.order = 2 if (omega_max is not None
+                           and omega_max / omega_1 > self.START_RATIO) else 5
+        self.first = self.order
+        self.mode = "first"  # first window; then "trial" of the other order; then "run"
+        self.length = self._window(self.order)
         self.count = 0
         self.t_mark = None
-        self.note = ("no highest frequency: order 5 kept" if omega_max is None else
-                     f"order 5: rtol {rtol:g} < {self.TIGHT_RTOL:g} (at tight tolerances order 5 "
-                     "takes far fewer steps)" if rtol < self.TIGHT_RTOL else "")
+        self.incumbent = self.order
+        self.interval = self.FIRST_INTERVAL
+        self.rate = {}  # latest steps per simulated second measured at each order
+        self.races = []  # (t, steps/s at 5, steps/s at 2, chosen)
+        self.skipped = 0  # races not run because order 5 cannot win
+        self.short = 0  # races not run because too little of the step was left
+        self.since = None  # time the current order was chosen
+        self.t_first = None  # time of the first step
+        self.n_first = 0  # steps of the first window
+        self.note = ("no highest frequency: order 5 kept" if omega_max is None else "")
+
+    def restart(self) -> None:
+        """IDA was started again (a kink or jump of a prescribed motion): the window's measured
+        half is taken after a new ramp."""
+        self.count = min(self.count, max(self.length - self.WINDOW, 0))
+        self.t_mark = None
+
+    def _window(self, order: int) -> int:
+        return self.WINDOW * (self.LONG2 if order == 2 else 1)
+
+    def _can_win(self, order: int) -> bool:
+        if order == 2:
+            return True
+        return not (2 in self.rate
+                    and self.MARGIN * self.rate[2] <= self.omega_max / self.STABILITY_HW)
 
     def observe(self, t: float) -> int | None:
         """Called after every step at time t; returns the new order cap when it changes."""
         self.count += 1
-        if self.t_mark is None:
+        self.n_first += self.mode == "first"
+        if self.t_first is None:
+            self.t_first = t
+        half = self.WINDOW // 2
+        if self.count == self.length - half:
             self.t_mark = t
-        if self.count < self.WINDOW:
+        if self.count < self.length or self.t_mark is None or t <= self.t_mark:
+            if self.count >= self.length:  # interrupted by restarts: measure a new half
+                self.count = self.length - half - 1
             return None
-        h = (t - self.t_mark) / self.count  # mean step of the window, s
+        if (self.mode == "first" and self.order == 2
+                and t - self.t_first < self.FIRST_TIME * 2.0 * np.pi / self.omega_1
+                and self.n_first < self.FIRST_MAX * self.WINDOW):
+            self.count = self.length - half - 1  # order 2 is still damping what the start
+            self.t_mark = None  # excited: measure a later half-window
+            return None
+        self.rate[self.order] = half / (t - self.t_mark)
         self.count = 0
-        self.t_mark = t
-        if self.phase == "start-up":  # a new IDA starts at order 1 with short steps
-            self.phase = "order 5"
+        self.t_mark = None
+        other = 7 - self.order
+        if self.mode in ("first", "run"):
+            if self.since is None:
+                self.since = t
+            left = self.rate[self.order] * (self.t_end - t)  # steps still to go, about
+            if left < self.MIN_REMAINING * self._window(other):
+                self.short += 1
+            elif self._can_win(other):
+                self.incumbent = self.order
+                self.mode = "trial"
+                self.length = self._window(other)
+                self.order = other
+                return other
+            else:
+                self.skipped += 1
+            self.mode = "run"
+            self.length = self.interval * self.WINDOW
             return None
-        # every later window at order 5 is tested again: an early window can be unrepresentative
-        # (IDA's first step scales with the step's duration, and order 5 may run long steps
-        # before the fast modes hold it down)
-        hw = h * self.omega_max
-        per_period = 2.0 * np.pi / (h * self.omega_1) if h > 0 else np.inf
-        if hw < self.STABILITY_HW and per_period > self.STEPS_PER_PERIOD:
-            self.decided = True
-            self.order = 2
-            self.note = (f"order 2 from t = {t:.6g} s: order 5 was stability-bound (h ω_max = "
-                         f"{hw:.3g}) at {per_period:.3g} steps per period of the lowest mode")
-            return 2
-        self.note = (f"order 5: h ω_max = {hw:.3g}, {per_period:.3g} steps per period of the "
-                     "lowest mode")
+        # end of a trial: the cheaper goes on
+        trial, inc = self.order, self.incumbent
+        best = trial if self.rate[trial] < self.MARGIN * self.rate[inc] else inc
+        self.races.append((t, self.rate[5], self.rate[2], best))
+        if best == self.incumbent:
+            self.interval *= 2
+        else:
+            self.interval = self.FIRST_INTERVAL
+            self.since = t
+        self.mode = "run"
+        self.length = self.interval * self.WINDOW
+        if best != self.order:
+            self.order = best
+            return best
         return None
 
     def summary(self) -> str:
-        return self.note or f"order {self.order} ({self.phase}: too few steps to measure)"
+        if self.note:
+            return self.note
+        text = f"order {self.order}"
+        if self.races:
+            t, r5, r2, _ = self.races[-1]
+            text += (f" (started at {self.first}; since t = {self.since:.4g} s): last race at "
+                     f"t = {t:.4g} s, {r2:.4g} steps/s at order 2 vs {r5:.4g} at order 5; "
+                     f"{len(self.races)} race(s), chosen "
+                     + ", ".join(str(b) for *_, b in self.races))
+        elif self.rate:
+            text += f" (started at {self.first}): {self.rate.get(self.order, 0):.4g} steps/s"
+        else:
+            text += f" (started at {self.first}; too few steps to measure)"
+        if self.skipped:
+            text += (f"; order 5 not tried {self.skipped} time(s): its stability bound "
+                     f"ω_max/{self.STABILITY_HW:g} = {self.omega_max / self.STABILITY_HW:.4g} "
+                     f"steps/s against {self.rate.get(2, 0):.4g} measured at order 2")
+        if self.short:
+            text += (f"; {self.short} race(s) left out: fewer than {self.MIN_REMAINING} trial "
+                     "windows of steps to go")
+        return text
 
 
 def _extreme_frequency(prob: TransientProblem, t0: float, y0: np.ndarray,

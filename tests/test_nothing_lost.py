@@ -43,9 +43,10 @@ def gentle():
     50 elements are the converged mesh for y: 100 elements (at max_order 5, 200 s of CPU, too
     slow here) are 0.57 mm from them (0.8 % of the 68.7 mm peak) and their peaks agree to
     0.02 %. Not for z: there 50 and 100 elements at order 5 are 0.97 mm apart (6 % of the
-    16.6 mm peak), the default max_order runs 50 elements at order 2, 0.57 mm from order 5, and
-    the lumped mass at 50 elements is 2 mm from them, so z is left to
-    benchmarks/nothing_lost.md (10 elements' z peak: -4.55 % against 100 at order 5)."""
+    16.6 mm peak), the default max_order (a race of orders 2 and 5) now runs 50 elements at
+    order 5 (benchmarks/speed_accuracy.md §8), and the lumped mass at 50 elements is 2 mm from
+    them, so z is left to benchmarks/nothing_lost.md (10 elements' z peak: -4.55 % against 100
+    at order 5)."""
     out = {}
     for n in (10, 50):
         ds = catdae.run(CASES / "example2_support_motion_gentle.toml", elements=n,
