@@ -195,11 +195,8 @@ class _StepsPass:
 
     def damping(self, raw: dict, step_where: tuple) -> Damping | None:
         where = step_where + ("damping",)
-        kind = self.kind_of(raw, where, _DAMPING_MODELS, "damping kind")
+        kind, v = self.kinded(raw, where, _DAMPING_MODELS, "damping kind")
         if kind is None:
-            return None
-        v, complete = self.validate(_DAMPING_MODELS[kind], raw, where)
-        if not complete:
             return None
         if kind == "material":
             return Damping("material")

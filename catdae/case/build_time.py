@@ -37,15 +37,21 @@ class _TimePass:
             self.problem(where + ("kind",), f"expected a string, found {_found(kind)}")
         return None
 
+    def kinded(self, raw: dict, where: tuple, models: Mapping, what: str):
+        """(kind, validated fields) of a table with a ``kind`` key choosing its model, or
+        (None, None) where the kind or a field is wrong (the problems are recorded)."""
+        kind = self.kind_of(raw, where, models, what)
+        if kind is None:
+            return None, None
+        v, complete = self.validate(models[kind], raw, where)
+        return (kind, v) if complete else (None, None)
+
     def time_function(self, raw: dict, where: tuple, motion: bool = False
                       ) -> TimeFunction | None:
         """A time function; ``motion``: it prescribes a support's displacement (a ``table``
         may then be a velocity or acceleration record)."""
-        kind = self.kind_of(raw, where, _TIME_MODELS, "time function kind")
+        kind, v = self.kinded(raw, where, _TIME_MODELS, "time function kind")
         if kind is None:
-            return None
-        v, complete = self.validate(_TIME_MODELS[kind], raw, where)
-        if not complete:
             return None
         if kind == "constant":
             tf: TimeFunction | None = Constant(float(v.value))
