@@ -111,6 +111,11 @@ class Model:
                 tf = getattr(sm, ax)
                 if tf is not None:
                     self.motions.append((3 * i + a, tf))
+        # the motions by their place among the fixed dofs (support_values, once per residual)
+        slots = np.searchsorted(self.fixed, [dof for dof, _ in self.motions]).astype(int)
+        self._fixed_motions = [(int(k), tf) for k, (dof, tf) in zip(slots, self.motions,
+                                                                      strict=True)
+                               if k < self.fixed.size and self.fixed[k] == dof]
         ld = self.loading
         self.elements = Elements(mesh.L0, mesh.EA, mesh.w,
                                  PointLoads(ld.internal_ptr, ld.internal_s,
@@ -142,12 +147,11 @@ class Model:
 
     def support_values(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Prescribed displacement, velocity and acceleration of the fixed dofs, (n_fixed,)."""
-        u = np.zeros(self.n_dof)
-        v = np.zeros(self.n_dof)
-        a = np.zeros(self.n_dof)
-        for dof, tf in self.motions:
-            u[dof], v[dof], a[dof] = tf.evaluate(t)
-        return u[self.fixed], v[self.fixed], a[self.fixed]
+        nf = self.fixed.size
+        u, v, a = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+        for k, tf in self._fixed_motions:
+            u[k], v[k], a[k] = tf.evaluate(t)
+        return u, v, a
 
     def breakpoints(self, t0: float, t1: float, rel: float = 1e-10) -> list[tuple[float, float]]:
         """Where a support motion or a load has a kink or a jump, in (t0, t1]: a sorted list of

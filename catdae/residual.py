@@ -170,6 +170,7 @@ class TransientProblem:
         ld = m.loading
         self._p_const = None if ld.node_timed else m.nodal_load(0.0)
         self._fixed = np.ascontiguousarray(m.fixed, np.int64)
+        self._x0_fixed = m.mesh.X0.reshape(-1)[m.fixed]  # reference positions of fixed dofs
         self._fidx = np.ascontiguousarray(self.fidx, np.int64)
         self._conn = np.ascontiguousarray(m.mesh.conn, np.int64)
         self._edofs = np.ascontiguousarray(m.edofs, np.int64)
@@ -214,7 +215,7 @@ class TransientProblem:
         if self._support_t != t:
             m = self.model
             u, v, a = m.support_values(t)
-            self._sup = (m.mesh.X0.reshape(-1)[m.fixed] + u, v, a)
+            self._sup = (self._x0_fixed + u, v, a)
             self._support_t = t
         return self._sup
 
