@@ -183,7 +183,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
                        and abs(times[k_done] - t_int) <= 1e-13 * max(abs(t_int), 1.0)):
                     record(k_done, times[k_done], y_last, yp_last)
                     k_done += 1
-            elif order_choice is not None and not order_choice.decided:
+            elif order_choice is not None and order_choice.measuring:
                 new_order = order_choice.observe(t_int)
                 if new_order is not None:
                     solver = make_solver(new_order)
@@ -257,7 +257,6 @@ class OrderChoice:
         self.t_end = t_end
         self.omega_max = omega_max
         self.omega_1 = omega_1
-        self.decided = omega_max is None  # nothing to measure against: order 5 kept
         self.order = 2 if (omega_max is not None
                            and omega_max / omega_1 > self.START_RATIO) else 5
         self.first = self.order
@@ -275,6 +274,11 @@ class OrderChoice:
         self.t_first = None  # time of the first step
         self.n_first = 0  # steps of the first window
         self.note = ("no highest frequency: order 5 kept" if omega_max is None else "")
+
+    @property
+    def measuring(self) -> bool:
+        """False without ω_max: nothing to measure against, order 5 kept."""
+        return self.omega_max is not None
 
     def restart(self) -> None:
         """IDA was started again (a kink or jump of a prescribed motion): the window's measured
