@@ -48,3 +48,15 @@ def test_a_missing_or_read_only_cache_folder_is_no_error(tmp_path):
     assert not purge_stale(tmp_path)  # creates the folder and the digest, deletes nothing
     assert (tmp_path / "__pycache__" / "catdae-kernels.sha256").is_file()
     assert not purge_stale(tmp_path / "missing")  # sources missing: no error, nothing done
+
+
+def test_every_module_with_compiled_kernels_is_in_the_digest():
+    """A module with numba kernels left out of KERNEL_MODULES would bring the stale-cache
+    problem back for its callers."""
+    from pathlib import Path
+
+    import catdae
+
+    root = Path(catdae.__file__).parent
+    with_kernels = {p.stem for p in root.rglob("*.py") if "@njit" in p.read_text()}
+    assert with_kernels == set(KERNEL_MODULES)
