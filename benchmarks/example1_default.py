@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -39,6 +38,9 @@ import numpy as np  # noqa: E402
 
 import catdae  # noqa: E402
 from catdae.cli import default_case_path  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from transient_speed import machine  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -95,18 +97,6 @@ def measure(case, repeats: int):
         _, z, cpu, ds = run_release(case)
         cpus.append(cpu)
     return z, cpus, ds
-
-
-def machine() -> str:
-    up = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
-    un = " ".join(platform.uname()[i] for i in (0, 2, 4))
-    import numba
-    import scipy
-    import sksundae
-    return (f"{un}, {os.cpu_count()} logical CPUs; python {platform.python_version()}, numpy "
-            f"{np.__version__}, scipy {scipy.__version__}, numba {numba.__version__}, "
-            f"scikit-sundae {sksundae.__version__}, catdae {catdae.__version__}; "
-            f"OMP_NUM_THREADS={os.environ['OMP_NUM_THREADS']}; uptime: {up}")
 
 
 def main(argv=None):

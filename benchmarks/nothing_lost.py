@@ -236,38 +236,43 @@ def violent_energy():
                 f"{lo}-{hi} kJ (README, 10-50 el)", ok, cost(r))
 
 
-def snow_gust():
-    name = "snow_gust_ground_record.toml"
-    bundled = run(name, "shaking", ["cable.5"])
-    tight = run(name, "shaking", ["cable.5"], rtol=1e-8, atol=1e-9)
-    fine = run(name, "shaking", ["cable.20"], elements=40, rtol=1e-6, atol=1e-7)
-    u, ut, uf = (x["disp"][:, 0] for x in (bundled, tight, fine))
+def _g(x: float) -> str:
+    return f"{x:g}".replace("e-0", "e-")
+
+
+def _bundled_against_tight_and_fine(label, name, step, node, fine_node, tight, fine, keep=None,
+                                    digits=(3, 2)):
+    """Two rows: the bundled case's history at ``node`` against the same mesh at tighter
+    tolerances (``tight``) and against a finer mesh (``fine``: elements and tolerances, its
+    node ``fine_node`` at the same place), the latter also in % of the fine mesh's peak."""
+    bundled = run(name, step, [node], keep=keep)
+    tight_run = run(name, step, [node], keep=keep, **tight)
+    fine_run = run(name, step, [fine_node], keep=keep, **fine)
+    u, ut, uf = (x["disp"][:, 0] for x in (bundled, tight_run, fine_run))
     peak = np.abs(uf).max(axis=0)
     d = maxdiff(u, ut)
-    row("snow_gust (10 el, consistent, rtol 1e-6)", "cable.5 x, y, z, 3 s: vs rtol 1e-8",
-        ", ".join(f"{v * 1e3:.3f}" for v in d) + " mm", "none", None, cost(bundled, tight))
+    row(label, f"{node} x, y, z: vs rtol {_g(tight['rtol'])}",
+        ", ".join(f"{v * 1e3:.{digits[0]}f}" for v in d) + " mm", "none", None,
+        cost(bundled, tight_run))
     d = maxdiff(u, uf)
-    row("snow_gust", "cable.5 x, y, z: vs 40 el rtol 1e-6 (of the peak)",
-        ", ".join(f"{v * 1e3:.2f}" for v in d) + " mm ("
+    row(label.split(" (")[0], f"{node} x, y, z: vs {fine['elements']} el rtol {_g(fine['rtol'])} "
+        "(of the peak)", ", ".join(f"{v * 1e3:.{digits[1]}f}" for v in d) + " mm ("
         + ", ".join(f"{100 * v / p:.1f} %" for v, p in zip(d, peak, strict=True)) + ")",
-        "none", None, cost(fine))
+        "none", None, cost(fine_run))
+
+
+def snow_gust():
+    _bundled_against_tight_and_fine(
+        "snow_gust (10 el, mass_model auto, rtol 1e-6, 3 s)", "snow_gust_ground_record.toml",
+        "shaking", "cable.5", "cable.20", dict(rtol=1e-8, atol=1e-9),
+        dict(elements=40, rtol=1e-6, atol=1e-7))
 
 
 def format_example():
-    name, keep = "format_example.toml", ("hanging", "release")
-    bundled = run(name, "release", ["main.7"], keep=keep)
-    tight = run(name, "release", ["main.7"], keep=keep, rtol=1e-8, atol=1e-10)
-    fine = run(name, "release", ["main.28"], keep=keep, elements=56, rtol=1e-7, atol=1e-9)
-    u, ut, uf = (x["disp"][:, 0] for x in (bundled, tight, fine))
-    peak = np.abs(uf).max(axis=0)
-    d = maxdiff(u, ut)
-    row("format_example (14 el, consistent, rtol 1e-6)", "main.7 x, y, z, 4 s: vs rtol 1e-8",
-        ", ".join(f"{v * 1e3:.3f}" for v in d) + " mm", "none", None, cost(bundled, tight))
-    d = maxdiff(u, uf)
-    row("format_example", "main.7 x, y, z: vs 56 el rtol 1e-7 (of the peak)",
-        ", ".join(f"{v * 1e3:.1f}" for v in d) + " mm ("
-        + ", ".join(f"{100 * v / p:.1f} %" for v, p in zip(d, peak, strict=True)) + ")",
-        "none", None, cost(fine))
+    _bundled_against_tight_and_fine(
+        "format_example (14 el, mass_model auto, rtol 1e-6, 4 s)", "format_example.toml", "release",
+        "main.7", "main.28", dict(rtol=1e-8, atol=1e-10), dict(elements=56, rtol=1e-7, atol=1e-9),
+        keep=("hanging", "release"), digits=(3, 1))
 
 
 PARTS = {"example1": example1, "gentle": example2_gentle, "violent": example2_violent,

@@ -113,26 +113,32 @@ def run_catdae(n: int, rtol: float, **kw) -> dict:
             "step_wall": float(ds.attrs["wall_time"])}
 
 
+def children_cost(fn, *args, **kw):
+    """(fn's result, wall s, CPU s of the child processes fn ran: user + system)."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    out = fn(*args, **kw)
+    wall = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return out, wall, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+
+
 def whole_catdae(n: int, rtol: float, folder: Path, max_order: str | int = "auto") -> dict:
     """``python -m catdae run`` in a new process: wall and CPU time of the whole process, and
     the run's midspan z history and step count (read back from its results file)."""
     path = folder / f"case_{n}_{rtol:g}_{max_order}.toml"
     path.write_text(case_text(n, rtol, max_order=max_order))
     out = folder / f"out_{n}_{rtol:g}_{time.time_ns()}.nc"
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    p = subprocess.run([sys.executable, "-m", "catdae", "run", str(path), "-o", str(out),
-                        "--no-progress"], capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p, wall, cpu = children_cost(
+        subprocess.run, [sys.executable, "-m", "catdae", "run", str(path), "-o", str(out),
+                         "--no-progress"], capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(p.stderr[-2000:])
     ds = catdae.read_results(out)["motion"].ds
     z = ds.position.sel(node=f"c.{n // 2}", axis="z").values
     steps = int(ds.attrs["n_steps"])
     out.unlink(missing_ok=True)
-    return {"wall": wall, "cpu": (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime),
-            "z": z, "steps": steps}
+    return {"wall": wall, "cpu": cpu, "z": z, "steps": steps}
 
 
 def ops_job(n: int) -> dict:
@@ -153,16 +159,12 @@ def ops_job(n: int) -> dict:
 
 def run_ops(job: dict, dt: float, env: dict) -> dict:
     every = int(round(0.01 / dt))
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    out = oc.run_opensees(dict(job, dt=dt, every=every), env)
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    out, wall, cpu = children_cost(oc.run_opensees, dict(job, dt=dt, every=every), env)
     z = np.asarray(out["mid"])[:, 2]
     return {"code": "OpenSees", "ne": job["ne"], "dt": dt, "z": z, "status": out["status"],
             "analysis_wall": out["wall"], "analysis_cpu": out["cpu"],
             "process_wall": wall,
-            "process_cpu": (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)}
+            "process_cpu": cpu}
 
 
 def err(z: np.ndarray, zref: np.ndarray) -> float:

@@ -10,12 +10,10 @@ of each process: median and spread over the repeats.
 """
 import argparse
 import os
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -27,12 +25,8 @@ PROBE = ("import sys, dask.array; from catdae.cli import main; "
 
 
 def one(argv: list[str]) -> tuple[float, float]:
-    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    t0 = time.perf_counter()
-    subprocess.run(argv, check=True, capture_output=True)
-    wall = time.perf_counter() - t0
-    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), wall
+    _, wall, cpu = sa.children_cost(subprocess.run, argv, check=True, capture_output=True)
+    return cpu, wall
 
 
 def main() -> None:
