@@ -1,4 +1,4 @@
-"""Element solve rate of ``catdae.element`` (numba kernel) against a pure-numpy reference.
+"""Element solve rate of ``catdae.element.elements`` (numba kernel) against a pure-numpy reference.
 
 Run apart from the test suite:  python benchmarks/element_speed.py [--quick]
 
@@ -32,7 +32,7 @@ import numba
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from catdae.element import CONVERGED, Elements, PointLoads  # noqa: E402
+from catdae.element.elements import CONVERGED, Elements, PointLoads  # noqa: E402
 
 SIZES = (1, 14, 100, 1000, 10000)
 TARGET_RATE = 1e6  # warm solves/s for batches >= 1000

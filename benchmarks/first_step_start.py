@@ -19,7 +19,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import speed_accuracy as sa  # noqa: E402
 
 import catdae  # noqa: E402
-import catdae.transient as tr  # noqa: E402
+import catdae.solvers.transient as tr  # noqa: E402
 from catdae.case import case_from_dict  # noqa: E402
 
 args = sys.argv[1:] + ["1000", "1e-4", "1.0"][len(sys.argv) - 2:]

@@ -35,11 +35,11 @@ import scipy
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 import catdae  # noqa: E402
-from catdae.assembly import Model  # noqa: E402
 from catdae.case import Step  # noqa: E402
-from catdae.mesh import build_mesh  # noqa: E402
-from catdae.modal import DENSE_LIMIT, solve_modal  # noqa: E402
-from catdae.static import solve_static  # noqa: E402
+from catdae.model.assembly import Model  # noqa: E402
+from catdae.model.mesh import build_mesh  # noqa: E402
+from catdae.solvers.modal import DENSE_LIMIT, solve_modal  # noqa: E402
+from catdae.solvers.static import solve_static  # noqa: E402
 
 EXAMPLE1 = HERE.parent / "cases" / "example1_free_vibration.toml"
 SIZES = (10, 100, 1000)
@@ -210,7 +210,7 @@ def main() -> None:
     t += [
         "",
         "The consistent mass of the catenary interpolation functions converges at order 2 from "
-        "above (tests/test_modal.py measures the rate). At 14 elements its excess over the "
+        "above (tests/scenes/test_modal.py measures the rate). At 14 elements its excess over the "
         "converged mesh follows the dispersion of linearly interpolated consistent string "
         "elements, f_h/f = sqrt(6 (1 - cos θ)/(θ² (2 + cos θ))) ≈ 1 + θ²/24 with θ = kh = "
         "(2j - 1)π/14 for symmetric mode j: +0.2, +1.9, +5.3, +10.2, +16.0 % against 224 "

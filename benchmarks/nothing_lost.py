@@ -176,7 +176,8 @@ def example2_gentle():
         cost(blended10))
     d = maxdiff(yz[10], tight10["disp"][:, 0, 1:])
     row("example2 gentle", "10 el: rtol 1e-5 vs 1e-7, y, z",
-        f"{d[0] * 1e3:.3f}, {d[1] * 1e3:.3f} mm", "< 1 % of the peak (tests/test_support_jump.py)",
+        f"{d[0] * 1e3:.3f}, {d[1] * 1e3:.3f} mm",
+        "< 1 % of the peak (tests/scenes/test_support_jump.py)",
         bool(np.all(d < 0.01 * peak)), cost(tight10))
     for n in (10, 50):
         d = maxdiff(yz[n], lumped[n]["disp"][:, 0, 1:])

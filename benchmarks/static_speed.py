@@ -22,16 +22,16 @@ import scipy
 import scipy.sparse.linalg as spla
 
 import catdae
-from catdae.assembly import Model
 from catdae.case import case_from_dict
-from catdae.mesh import build_mesh
-from catdae.static import solve_static
+from catdae.model.assembly import Model
+from catdae.model.mesh import build_mesh
+from catdae.solvers.static import solve_static
 
 L0, SPAN, EA, MASS, G = 110.0, 100.0, 1.0e7, 5.0, 9.81
 
 
 def make_case(ne: int, slack: bool = False, load_steps: int = 1):
-    """The benchmark cable; ``slack``: the hard scene of tests/test_static.py (span 10 m,
+    """The benchmark cable; ``slack``: the hard scene of tests/scenes/test_static.py (span 10 m,
     L0 = 15 m, EA = 3.4e7 N, 100 times the weight at 0.4 L0)."""
     span, l0, ea, factor, at = (10.0, 15.0, 3.4e7, 100.0, 0.4) if slack else \
         (SPAN, L0, EA, 20.0, 0.3)
@@ -103,7 +103,7 @@ def main() -> None:
         print(f"| {ne} | {r['iterations']} | {r['increments']} | {r['solve']:.3f} | "
               f"{r['lu']:.3f} | {per:.2f} | {r['run']:.3f} | {r['residual']:.1e} |")
     print()
-    print("Slack cable, 100 times its weight (tests/test_static.py):")
+    print("Slack cable, 100 times its weight (tests/scenes/test_static.py):")
     print("| elements | load_steps | Newton iterations | load increments | solve_static (s) |")
     print("|---:|---:|---:|---:|---:|")
     for ne in (10, 100, 1000):

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
-
-from ._kernel_cache import purge_stale as _purge_stale
-from .errors import (
+from catdae._version import __version__
+from catdae.element.cache import purge_stale as _purge_stale
+from catdae.errors import (
     CaseError,
     CatdaeError,
     ConvergenceError,
@@ -14,11 +13,6 @@ from .errors import (
     SolverError,
 )
 
-try:
-    __version__ = version("catdae")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
-    __version__ = "0.0.0+unknown"
-
 # numba's cache follows each kernel's own file only: drop cached kernels whose callees changed
 _purge_stale()
 
@@ -26,21 +20,21 @@ _purge_stale()
 
 def run(case_or_path, **kwargs):
     """Run every step of a case (path, TOML text or Case); see :func:`catdae.analysis.run`."""
-    from .analysis import run as _run
+    from catdae.analysis import run as _run
 
     return _run(case_or_path, **kwargs)
 
 
 def load_case(path_or_text, **kwargs):
     """Read and validate a case file; see :func:`catdae.case.load_case`."""
-    from .case import load_case as _load
+    from catdae.case import load_case as _load
 
     return _load(path_or_text, **kwargs)
 
 
 def read_results(path):
     """Open a results file written by catdae as an ``xarray.DataTree`` (in memory)."""
-    from .results import read_tree
+    from catdae.output.results import read_tree
 
     return read_tree(path)
 
@@ -50,9 +44,10 @@ __all__ = ["CaseError", "CatdaeError", "ConvergenceError", "Interrupted", "Outpu
 
 
 def __getattr__(name):
-    """``catdae.plot`` and ``catdae.export`` on first use (matplotlib and meshio load then)."""
+    """``catdae.plot`` and ``catdae.export`` (catdae/output/) on first use (matplotlib, meshio
+    load then)."""
     if name in ("plot", "export"):
         import importlib
 
-        return importlib.import_module(f".{name}", __name__)
+        return importlib.import_module(f"catdae.output.{name}")
     raise AttributeError(f"module 'catdae' has no attribute {name!r}")

@@ -13,17 +13,18 @@ from pathlib import Path
 
 import numpy as np
 
-from . import formfind, results
-from ._xr import xr
-from .assembly import Model
-from .case import Case, Step, load_case
-from .element import NOT_CONVERGED
-from .errors import CaseError, CatdaeError, ConvergenceError, OutputError
-from .frame import rotate_back, to_gravity_frame
-from .interrupts import deferred
-from .mesh import build_mesh
-from .modal import solve_modal
-from .static import solve_static
+from catdae._xr import xr
+from catdae.case import Case, Step, load_case
+from catdae.case.frame import rotate_back, to_gravity_frame
+from catdae.element.elements import NOT_CONVERGED
+from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutputError
+from catdae.interrupts import deferred
+from catdae.model import formfind
+from catdae.model.assembly import Model
+from catdae.model.mesh import build_mesh
+from catdae.output import results
+from catdae.solvers.modal import solve_modal
+from catdae.solvers.static import solve_static
 
 
 class _State:
@@ -55,7 +56,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     ov = {k: v for k, v in overrides.items() if v is not None}
     if ov:
         case = case.with_overrides(**ov)
-    # solved where gravity is -z (catdae.frame); vector results are rotated back
+    # solved where gravity is -z (catdae.case.frame); vector results are rotated back
     local, rotation = to_gravity_frame(case)
     local = formfind.initial_lengths(local)  # form-found lengths: a start
     find_forms = bool(formfind.pending(local))
@@ -154,14 +155,14 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
         return _static_step(step, model, state)
     if step.kind == "modal":
         return _modal_step(step, model, state)
-    from .transient import run_transient  # the only module that imports sksundae
+    from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 
     return run_transient(step, model, state, writer, progress)
 
 
 def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _State):
     """The first static step of a case with form-found cables: the lengths such that their
-    targets hold in it (catdae.formfind). Returns (case with the lengths, its mesh at the
+    targets hold in it (catdae.model.formfind). Returns (case with the lengths, its mesh at the
     reference temperature, the step's model, its dataset)."""
 
     def evaluate(trial: Case, warm):

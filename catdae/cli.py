@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
-from .errors import CaseError, CatdaeError, OutputError
-from .interrupts import signals_as_interrupts
+from catdae._version import __version__
+from catdae.errors import CaseError, CatdaeError, OutputError
+from catdae.interrupts import signals_as_interrupts
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.plot.WHAT
+WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.output.plot.WHAT
 
 DEFAULT_CASE = "example1_free_vibration.toml"
 
@@ -75,7 +75,7 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["study"]:  # its options (and -h) belong to catdae.study
-        from .study import main as study_main
+        from catdae.study import main as study_main
 
         return study_main(argv[1:])
     args = _parser().parse_args(argv)
@@ -90,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
             if args.command == "export":
                 return _export(args)
             if args.command == "study":
-                from .study import main as study_main
+                from catdae.study import main as study_main
 
                 return study_main(list(args.rest))
     except CaseError as exc:
@@ -121,8 +121,8 @@ def _say_where(exc: BaseException, when: str) -> None:
 
 
 def _check(args) -> int:
-    from .analysis import check_case
-    from .case import load_case
+    from catdae.analysis import check_case
+    from catdae.case import load_case
 
     case = load_case(Path(args.case))  # the command line always names a file
     mesh = check_case(case)
@@ -132,8 +132,8 @@ def _check(args) -> int:
 
 
 def _run(args) -> int:
-    from .analysis import check_output, run
-    from .case import load_case
+    from catdae.analysis import check_output, run
+    from catdae.case import load_case
 
     path = Path(args.case) if args.case else default_case_path()
     case = load_case(path)
@@ -143,7 +143,7 @@ def _run(args) -> int:
     except OutputError as exc:  # judged before any work: a usage error
         print(f"catdae: {exc}", file=sys.stderr)
         return 2
-    from .element import kernels_cached
+    from catdae.element.elements import kernels_cached
 
     if not kernels_cached():
         print("catdae: compiling the element kernels for this machine (once after install or "
@@ -160,7 +160,7 @@ def _run(args) -> int:
     print(summary(tree))
     print(f"results written to {out}")
     if args.vtk:
-        from .export import write_vtk
+        from catdae.output.export import write_vtk
 
         for p in write_vtk(tree, args.vtk):
             print(f"ParaView time series written to {p}")
@@ -168,8 +168,8 @@ def _run(args) -> int:
 
 
 def _plot(args) -> int:
-    from .plot import write_all
-    from .results import read_tree
+    from catdae.output.plot import write_all
+    from catdae.output.results import read_tree
 
     if not Path(args.results).is_file():
         print(f"catdae: no results file {args.results}", file=sys.stderr)
@@ -187,8 +187,8 @@ def _plot(args) -> int:
 
 
 def _export(args) -> int:
-    from .export import write_vtk
-    from .results import read_tree
+    from catdae.output.export import write_vtk
+    from catdae.output.results import read_tree
 
     if not Path(args.results).is_file():
         print(f"catdae: no results file {args.results}", file=sys.stderr)

@@ -16,7 +16,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from .errors import Interrupted
+from catdae.errors import Interrupted
 
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
 

@@ -4,7 +4,7 @@
 
 Everything comes from the public interface, ``catdae.load_case`` and ``catdae.run`` on the case
 files in ``cases/``; the paper's own numbers are typed in below from its Table 2. The test
-``tests/test_figures.py`` runs :func:`render` and checks the numbers it returns against the
+``tests/scenes/test_figures.py`` runs :func:`render` and checks the numbers it returns against the
 paper, so that ``python -m pytest`` rebuilds the figures every time the suite runs.
 
 - ``table2.png``: natural frequencies of example 1 (in-plane symmetric modes 1-5): catdae at the

@@ -31,7 +31,7 @@ explained:
   (regular files only, bounded, table files confined to the case's folder).
 """
 
-from .model import (
+from catdae.case.model import (
     AXES,
     Cable,
     Case,
@@ -45,7 +45,7 @@ from .model import (
     Step,
     SupportMotion,
 )
-from .read import case_from_dict, load_case
+from catdae.case.read import case_from_dict, load_case
 
 __all__ = [
     "AXES",

@@ -16,26 +16,26 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
-from ..errors import CaseError
-from ..frame import gravity_rotation, local_axes
-from .build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
-from .build_steps import _StepsPass
-from .build_time import _TimePass
-from .limits import size_problems
-from .messages import _fmt_path, _found, _is_number, _message, _short, _unknown
-from .model import (
+from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_steps import _StepsPass
+from catdae.case.build_time import _TimePass
+from catdae.case.frame import gravity_rotation, local_axes
+from catdae.case.limits import size_problems
+from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
+from catdae.case.model import (
     AXES,
     Case,
     FrozenMap,
     Material,
 )
-from .schema import (
+from catdae.case.schema import (
     _VEC3,
     _Load,
     _Material,
     _PointMass,
     _Top,
 )
+from catdae.errors import CaseError
 
 
 class _Builder(_CablesPass, _StepsPass, _TimePass):
@@ -165,7 +165,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         return norm, tuple(float(x) / norm for x in g)
 
     def gravity_supports(self, supports: dict) -> None:
-        """The scene is solved with gravity along local -z (catdae.frame): every support must
+        """The scene is solved with gravity along local -z (catdae.case.frame): every support must
         fix coordinate axes of that frame."""
         if self.gravity_direction == (0.0, 0.0, -1.0):
             return

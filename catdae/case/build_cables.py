@@ -11,15 +11,15 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from .messages import _found, _unknown
-from .model import (
+from catdae.case.messages import _found, _unknown
+from catdae.case.model import (
     Cable,
     DistributedLoad,
     Form,
     Load,
     PointMass,
 )
-from .schema import (
+from catdae.case.schema import (
     FORM_TARGETS,
     _Cable,
     _DistributedLoad,

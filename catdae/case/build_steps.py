@@ -8,15 +8,15 @@ import re
 import unicodedata
 from typing import Any
 
-from .messages import _fmt_path, _found, _is_number, _short, _unknown
-from .model import (
+from catdae.case.messages import _fmt_path, _found, _is_number, _short, _unknown
+from catdae.case.model import (
     AXES,
     Damping,
     FrozenMap,
     Step,
     SupportMotion,
 )
-from .schema import (
+from catdae.case.schema import (
     _DAMPING_MODELS,
     _STEP_MODELS,
     _SupportMotion,

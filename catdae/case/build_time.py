@@ -11,14 +11,14 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..records import AccelerationRecord, VelocityRecord
-from ..timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
-from .limits import FileProblem, confined, read_limited
-from .messages import _found, _short, _suggest, _unknown
-from .schema import (
+from catdae.case.limits import FileProblem, confined, read_limited
+from catdae.case.messages import _found, _short, _suggest, _unknown
+from catdae.case.records import AccelerationRecord, VelocityRecord
+from catdae.case.schema import (
     _TIME_MODELS,
     _TableTF,
 )
+from catdae.case.timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
 
 
 class _TimePass:

@@ -12,10 +12,10 @@ from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
-from ..errors import CaseError
-from ..timefunc import TimeFunction
-from .limits import MAX_ELEMENTS_PER_CABLE, size_problems
-from .messages import _found, _is_number
+from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
+from catdae.case.messages import _found, _is_number
+from catdae.case.timefunc import TimeFunction
+from catdae.errors import CaseError
 
 AXES = ("x", "y", "z")
 # docs/case-format.md, mass_model
@@ -96,7 +96,7 @@ class Cable:
     ``length`` is the unstrained length L0 in m (at the reference temperature); ``gauss_points``
     per element integrate mass, damping and distributed loads. Mesh nodes are ``<name>.<k>``,
     k = 1 .. elements - 1. With a ``form`` other than ``pretension`` the length is found by the
-    first static step and is ``None`` until then (see :mod:`catdae.formfind`).
+    first static step and is ``None`` until then (see :mod:`catdae.model.formfind`).
     """
 
     name: str

@@ -9,11 +9,11 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ..errors import CaseError
-from .build import _Builder
-from .limits import FileProblem, read_limited
-from .messages import _found
-from .model import Case
+from catdae.case.build import _Builder
+from catdae.case.limits import FileProblem, read_limited
+from catdae.case.messages import _found
+from catdae.case.model import Case
+from catdae.errors import CaseError
 
 
 def load_case(path_or_text: str | os.PathLike, *, name: str | None = None) -> Case:

@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
-from .limits import MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
+from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
 
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 

@@ -69,22 +69,22 @@ execution), ``store`` (the resumable store), ``dataset`` (errors and the Dataset
 from __future__ import annotations
 
 # ``name as name``: public as before, though not in __all__
-from .cli import main
-from .core import MODAL_SETTINGS as MODAL_SETTINGS
-from .core import SETTINGS, StudyError
-from .core import STORE_FORMAT as STORE_FORMAT
-from .core import configure as configure
-from .core import point_labels as point_labels
-from .core import reference_settings as reference_settings
-from .core import run_key as run_key
-from .core import settings_grid as settings_grid
-from .core import study_step as study_step
-from .plots import convergence_order, plot_convergence, plot_work_precision
-from .report import summary as summary
-from .report import write_study
-from .runner import local_cluster as local_cluster
-from .runner import run_study
-from .worker import execute
+from catdae.study.cli import main
+from catdae.study.core import MODAL_SETTINGS as MODAL_SETTINGS
+from catdae.study.core import SETTINGS, StudyError
+from catdae.study.core import STORE_FORMAT as STORE_FORMAT
+from catdae.study.core import configure as configure
+from catdae.study.core import point_labels as point_labels
+from catdae.study.core import reference_settings as reference_settings
+from catdae.study.core import run_key as run_key
+from catdae.study.core import settings_grid as settings_grid
+from catdae.study.core import study_step as study_step
+from catdae.study.plots import convergence_order, plot_convergence, plot_work_precision
+from catdae.study.report import summary as summary
+from catdae.study.report import write_study
+from catdae.study.runner import local_cluster as local_cluster
+from catdae.study.runner import run_study
+from catdae.study.worker import execute
 
 __all__ = ["SETTINGS", "StudyError", "convergence_order", "execute", "main", "plot_convergence",
            "plot_work_precision", "run_study", "write_study"]

@@ -7,10 +7,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..errors import CaseError
-from .core import _CHOICES, StudyError
-from .report import summary, write_study
-from .runner import run_study
+from catdae.errors import CaseError
+from catdae.study.core import _CHOICES, StudyError
+from catdae.study.report import summary, write_study
+from catdae.study.runner import run_study
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -50,7 +50,7 @@ def _reference_arg(items: list[str] | None):
     if not items:
         return None
     if len(items) == 1 and "=" not in items[0]:
-        from ..results import read_tree
+        from catdae.output.results import read_tree
 
         try:
             return read_tree(items[0])
@@ -77,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     """``catdae study CASE ...``: 0 all runs completed, 1 some failed (results still written),
     2 invalid case or settings, 130 interrupted."""
     args = _parser().parse_args(argv)
-    from ..case import load_case
+    from catdae.case import load_case
 
     try:
         case = load_case(args.case)

@@ -12,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from .. import __version__
-from ..case import AXES, Case, Step
-from ..errors import CatdaeError
+from catdae._version import __version__
+from catdae.case import AXES, Case, Step
+from catdae.errors import CatdaeError
 
 SETTINGS = ("rtol", "atol", "elements", "gauss_points", "mass_model", "linear_solver",
             "max_order")

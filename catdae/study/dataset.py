@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from .._xr import xr
-from ..case import Step
-from .core import _CHOICES, _COORD_META, _COUNTS, _MEMORY_NAMES
+from catdae._xr import xr
+from catdae.case import Step
+from catdae.study.core import _CHOICES, _COORD_META, _COUNTS, _MEMORY_NAMES
 
 
 def _motion(ref: xr.Dataset, label: str) -> float:

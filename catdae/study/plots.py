@@ -10,8 +10,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from .._xr import xr
-from .core import SETTINGS
+from catdae._xr import xr
+from catdae.study.core import SETTINGS
 
 
 def convergence_order(error: xr.DataArray, dim: str = "elements") -> float:

@@ -6,10 +6,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .._xr import xr
-from ..results import write_atomic
-from .core import SETTINGS
-from .plots import plot_convergence, plot_work_precision
+from catdae._xr import xr
+from catdae.output.results import write_atomic
+from catdae.study.core import SETTINGS
+from catdae.study.plots import plot_convergence, plot_work_precision
 
 
 def write_study(ds: xr.Dataset, path: str | os.PathLike, plots: bool = True) -> list[Path]:

@@ -13,12 +13,12 @@ from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
 
-from .. import __version__
-from .._xr import xr
-from ..analysis import as_case
-from ..case import AXES, Case, Step
-from ..errors import CaseError
-from .core import (
+from catdae._version import __version__
+from catdae._xr import xr
+from catdae.analysis import as_case
+from catdae.case import AXES, Case, Step
+from catdae.errors import CaseError
+from catdae.study.core import (
     _COUNTS,
     StudyError,
     _common_points,
@@ -30,9 +30,9 @@ from .core import (
     settings_grid,
     study_step,
 )
-from .dataset import _assemble
-from .store import _clean, _store_read, _store_write
-from .worker import _MemoryProbe
+from catdae.study.dataset import _assemble
+from catdae.study.store import _clean, _store_read, _store_write
+from catdae.study.worker import _MemoryProbe
 
 
 def run_study(case: Case | str | os.PathLike, *, step: str | None = None,

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._xr import xr
-from ..results import write_atomic
-from .core import STORE_FORMAT
+from catdae._xr import xr
+from catdae.output.results import write_atomic
+from catdae.study.core import STORE_FORMAT
 
 
 def _store_read(store: Path, key: str) -> xr.Dataset | None:

@@ -8,11 +8,11 @@ import sys
 import time
 from dataclasses import replace
 
-from .._xr import xr
-from ..analysis import run
-from ..case import AXES, Case, Step
-from ..errors import CatdaeError
-from .core import _COUNTS, StudyError, point_labels
+from catdae._xr import xr
+from catdae.analysis import run
+from catdae.case import AXES, Case, Step
+from catdae.errors import CatdaeError
+from catdae.study.core import _COUNTS, StudyError, point_labels
 
 _WARMED: set[tuple] = set()  # kinds of step already run once in this process
 

@@ -1,0 +1,109 @@
+"""Gravity along any direction: the scene is solved in a frame where gravity acts along -z.
+
+The element kernel (docs/theory.md §1-2) carries the weight along its -z axis: the tension
+vector is ``t(s) = h + (0, 0, w s) - Σ f_k``. A case whose ``gravity`` is a vector ``g`` is
+rotated, as a rigid body, into the frame where ``g`` points along -z; it is solved there and its
+vector results are rotated back. A rotation changes nothing physical, so this is exact.
+
+The rotation ``R`` (local = R global) has third row ``-ĝ``. Its first two rows are taken, where
+possible, from global axes perpendicular to ``ĝ`` (all of them when ``ĝ`` lies along an axis),
+so that supports fixing only some axes still fix coordinate axes in the rotated frame. A support
+whose fixed axes do not map onto local coordinate axes is rejected by the case validation
+(:func:`local_axes`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from catdae.case.model import AXES, Case, SupportMotion
+from catdae.case.timefunc import TimeFunction
+
+_TOL = 1e-12
+
+
+def gravity_rotation(direction) -> np.ndarray:
+    """The proper rotation (3, 3) taking the unit vector ``direction`` to -z."""
+    d = np.asarray(direction, float)
+    d = d / np.linalg.norm(d)
+    r3 = -d
+    free = [np.eye(3)[a] for a in range(3) if abs(d[a]) <= _TOL]
+    if free:
+        r1 = free[0]
+    else:  # the axis most nearly perpendicular to gravity, projected on the horizontal plane
+        a = int(np.argmin(np.abs(d)))
+        e = np.eye(3)[a]
+        r1 = e - (e @ r3) * r3
+        r1 /= np.linalg.norm(r1)
+    r2 = np.cross(r3, r1)
+    R = np.array([r1, r2, r3])
+    R[np.abs(R) <= _TOL] = 0.0
+    return R
+
+
+def local_axes(R: np.ndarray, axes: tuple[str, ...]) -> tuple[str, ...] | None:
+    """The local axes spanning the same subspace as the global ``axes``, or None if none do."""
+    cols = [AXES.index(a) for a in axes]
+    rows = sorted({b for b in range(3) for a in cols if abs(R[b, a]) > _TOL})
+    return tuple(AXES[b] for b in rows) if len(rows) == len(cols) else None
+
+
+@dataclass(frozen=True)
+class Combination(TimeFunction):
+    """``f(t) = Σ c_i f_i(t)``: one local axis of a rotated support motion."""
+
+    terms: tuple[tuple[float, TimeFunction], ...] = ()
+
+    def _evaluate(self, t):
+        f = df = d2f = 0.0
+        for c, fn in self.terms:
+            a, b, e = fn.evaluate(t)
+            f, df, d2f = f + c * a, df + c * b, d2f + c * e
+        return f, df, d2f
+
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(sorted({b for _, fn in self.terms for b in fn.breakpoints()}))
+
+
+def to_gravity_frame(case: Case) -> tuple[Case, np.ndarray | None]:
+    """``(case in the frame where gravity is -z, R)``; ``R`` is None when it already is."""
+    R = gravity_rotation(case.gravity_direction)
+    if np.array_equal(R, np.eye(3)):
+        return case, None
+
+    def rot(v):
+        return tuple(float(x) for x in R @ np.asarray(v, float))
+
+    supports = {n: local_axes(R, ax) for n, ax in case.supports.items()}
+    motions = []
+    for sm in case.support_motions:
+        funcs = {}
+        for b, name in enumerate(AXES):
+            terms = tuple((float(R[b, AXES.index(a)]), f) for a, f in sm.moved()
+                          if R[b, AXES.index(a)] != 0.0)
+            if terms:
+                funcs[name] = (terms[0][1] if terms == ((1.0, terms[0][1]),)
+                               else Combination(terms))
+        motions.append(SupportMotion(sm.node, **funcs))
+    local = replace(
+        case, gravity_direction=(0.0, 0.0, -1.0),
+        nodes={n: rot(x) for n, x in case.nodes.items()}, supports=supports,
+        loads=tuple(replace(ld, force=rot(ld.force)) for ld in case.loads),
+        distributed_loads=tuple(replace(d, load=rot(d.load)) for d in case.distributed_loads),
+        support_motions=tuple(motions),
+    )
+    return local, R
+
+
+def rotate_back(ds, R: np.ndarray | None):
+    """Every variable with an ``axis`` dimension (last) rotated from the local to the global
+    frame: v = Rᵀ v_local."""
+    if R is None:
+        return ds
+    out = ds.copy()
+    for name, var in ds.data_vars.items():
+        if var.dims and var.dims[-1] == "axis":
+            out[name] = var.copy(data=np.asarray(var.values) @ R)
+    return out

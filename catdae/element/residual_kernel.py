@@ -1,0 +1,86 @@
+"""The transient residual in one compiled pass (docs/theory.md §8).
+
+IDA calls the residual thousands of times per simulated second. Done as separate NumPy steps
+(scatter the unknowns, chords, element solve, mass, forces, gather) it spent as much time in
+Python between the compiled kernels as in them on meshes of tens of elements
+(benchmarks/speed_accuracy.md §7). ``residual_pass`` does all of it in one call and leaves the
+element state (tensions, flexibilities, stiffnesses, masses, ∂M/∂c) in the caller's buffers,
+where the iteration matrix and the outputs find it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from catdae.element.catenary import NOT_CONVERGED
+from catdae.element.mass import _dynamic_forces, _dynamics_one, _dynamics_work
+
+
+@njit(cache=True)
+def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, w, ptr, ls, lf,
+                  load_total, wl0, h, hw, use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm,
+                  want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
+                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res):
+    """r_q = q' - v and r_v = M v' + C v + g + F - P on the free dofs, into ``res`` (2n,).
+
+    y = [q, v] and yp interleaved per unknown; unknown k is full dof ``fidx[k]``; the fixed
+    dofs ``fixed`` have positions, velocities and accelerations ``xp, vp, ap``. The element
+    tensions start from ``h`` and are solved into ``hw``. ``want_m``/``want_c``/``want_dm``:
+    build the consistent mass, material damping and ∂M/∂c of the elements (times ``scale``:
+    the consistent share of a blended mass); ``use_m``/``use_c``: use ``me``/``ce`` in the
+    forces (given, when constant). ``m_diag`` and ``v_diag`` are the diagonal mass and the
+    diagonal damping (lumped parts, Rayleigh α M), ``p_nodal`` the nodal loads.
+
+    Returns False, with ``res`` untouched, where an element cannot be solved: the caller
+    rejects the trial state.
+    """
+    n = fidx.shape[0]
+    for k in range(n):
+        d = fidx[k]
+        X[d] = y[2 * k]
+        V[d] = y[2 * k + 1]
+        A[d] = yp[2 * k + 1]
+    for k in range(fixed.shape[0]):
+        d = fixed[k]
+        X[d] = xp[k]
+        V[d] = vp[k]
+        A[d] = ap[k]
+    xw, g6, fg, dkk, gm, bm, fm, nm, dn = _dynamics_work()
+    chord = np.empty(3)
+    ne = conn.shape[0]
+    for e in range(ne):
+        i = 3 * conn[e, 0]
+        j = 3 * conn[e, 1]
+        for a in range(3):
+            chord[a] = X[j + a] - X[i + a]
+            hw[e, a] = h[e, a]
+        _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, hw, use_h, tol, max_iter, gs, gw, mq,
+                      cq, pmptr, pms, pmm, want_m, want_c, want_dm, fflat, kmat, its, stat, me,
+                      ce, dm, xw, g6, fg, dkk, gm, bm, fm, nm, dn)
+        if stat[e] == NOT_CONVERGED:
+            return False
+        for a in range(3):
+            if not np.isfinite(hw[e, a]):
+                return False
+        if scale != 1.0:
+            if want_m:
+                for r in range(6):
+                    for c in range(6):
+                        me[e, r, c] *= scale
+            if want_c:
+                for r in range(6):
+                    for c in range(6):
+                        ce[e, r, c] *= scale
+            if want_dm:
+                for kk in range(3):
+                    for r in range(6):
+                        for c in range(6):
+                            dm[e, kk, r, c] *= scale
+    _dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm, want_dm, alpha,
+                    beta, V, A, force)
+    for k in range(n):
+        d = fidx[k]
+        res[2 * k] = yp[2 * k] - y[2 * k + 1]
+        res[2 * k + 1] = force[d] + m_diag[d] * A[d] + v_diag[d] * V[d] - p_nodal[d]
+    return True

@@ -1,0 +1,418 @@
+"""DOF map and sparse scatter of element vectors and matrices; the model of a step (its loading
+is built in ``loading``).
+
+Degrees of freedom are node-major: dof = 3 * node + axis. A :class:`Model` is what one analysis
+step sees: the mesh, the point masses and loads present in it (``active = false`` leaves one out
+until a step's ``add``, ``remove`` takes one away), the supports and their prescribed motion. It
+contains only what the scene has: no time functions when no load varies, no internal loads when
+none sit inside an element.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from catdae.case import Case
+from catdae.case.timefunc import TimeFunction
+from catdae.element.elements import Elements, ElementState, PointLoads
+from catdae.model.loading import (  # noqa: F401  (re-exported)
+    Loading,
+    build_loading,
+    choose_mass_model,
+    free_hanging_ends,
+)
+from catdae.model.mesh import AXES, Mesh
+
+# lumped fraction μ of mass_model = "blended": M = (1 - μ) M_consistent + μ M_lumped. μ = 1/2
+# cancels the leading (second-order) frequency error of the two, which have opposite signs
+# (docs/theory.md §7; measured in tests/scenes/test_modal.py and benchmarks/speed_accuracy.md)
+BLEND_LUMPED = 0.5
+
+
+class Pattern:
+    """CSR sparsity of element 6x6 blocks plus the diagonal, with a scatter map.
+
+    ``edofs`` (n_elem, 6) holds row/column numbers in ``0..n-1`` or -1 for entries to drop.
+    ``assemble(blocks, diag)`` sums (n_elem, 6, 6) blocks and an (n,) diagonal into the data
+    array in one bincount: no Python loop over elements.
+    """
+
+    def __init__(self, edofs: np.ndarray, n: int):
+        r = np.repeat(edofs, 6, axis=1)  # (n_elem, 36)
+        c = np.tile(edofs, (1, 6))
+        keep = (r >= 0) & (c >= 0)
+        keys_e = np.where(keep, r * n + c, -1).ravel()
+        diag = np.arange(n, dtype=np.int64) * (n + 1)
+        keys, inv = np.unique(np.concatenate([keys_e[keys_e >= 0], diag]), return_inverse=True)
+        self.n = n
+        self.nnz = keys.size
+        self.indices = (keys % n).astype(np.int32)
+        rows = keys // n
+        self.indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))]).astype(
+            np.int32)
+        n_e = int((keys_e >= 0).sum())
+        self._emap_full = np.full(keys_e.size, self.nnz, np.int64)  # dropped -> dump slot
+        self._emap_full[keys_e >= 0] = inv[:n_e]
+        self._dmap = inv[n_e:]
+
+    def assemble(self, blocks: np.ndarray | None = None, diag: np.ndarray | None = None,
+                 scale: float = 1.0) -> np.ndarray:
+        """CSR data array (nnz,) of scale * Σ blocks + diag."""
+        data = np.zeros(self.nnz + 1)
+        if blocks is not None:
+            data += np.bincount(self._emap_full, weights=blocks.reshape(-1),
+                                minlength=self.nnz + 1)
+        if diag is not None:
+            data[:-1][self._dmap] += diag
+        return scale * data[:-1] if scale != 1.0 else data[:-1]
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+
+
+
+
+class Model:
+    """What one analysis step sees: mesh, active loading, supports and their motion."""
+
+    def __init__(self, case: Case, mesh: Mesh, absent: set[str], mass_model: str = "auto",
+                 kind: str = "transient"):
+        """``absent``: names of the point masses and loads not present in this step;
+        ``mass_model`` "auto" is resolved for a step of ``kind`` (:func:`choose_mass_model`):
+        ``mass_model`` is then the model used, ``mass_model_choice`` says why."""
+        self.case = case
+        self.mesh = mesh
+        self.loading = build_loading(case, mesh, absent)
+        self.mass_model_setting = mass_model
+        if mass_model == "auto":
+            ends = free_hanging_ends(case, mesh, self.loading.node_mass)
+        else:
+            ends = []
+        self.mass_model, self.mass_model_choice = choose_mass_model(mass_model, kind, ends)
+        mass_model = self.mass_model
+        # the blend's lumped fraction μ: M = (1 - μ) M_consistent + μ M_lumped
+        self.lumped_fraction = {"blended": BLEND_LUMPED, "lumped": 1.0}.get(mass_model, 0.0)
+        nn = mesh.n_nodes
+        self.n_dof = 3 * nn
+        fixed = np.zeros((nn, 3), bool)
+        for node, axes in case.supports.items():
+            i = mesh.node_index(node)
+            for ax in axes:
+                fixed[i, AXES.index(ax)] = True
+        self.fixed_mask = fixed  # (n_nodes, 3)
+        self.fixed = np.flatnonzero(fixed.ravel())
+        self.free = np.flatnonzero(~fixed.ravel())
+        # support motion: (dof, TimeFunction) for prescribed displacements
+        self.motions: list[tuple[int, TimeFunction]] = []
+        for sm in case.support_motions:
+            i = mesh.node_index(sm.node)
+            for a, ax in enumerate(AXES):
+                tf = getattr(sm, ax)
+                if tf is not None:
+                    self.motions.append((3 * i + a, tf))
+        # the motions by their place among the fixed dofs (support_values, once per residual)
+        slots = np.searchsorted(self.fixed, [dof for dof, _ in self.motions]).astype(int)
+        self._fixed_motions = [(int(k), tf) for k, (dof, tf) in zip(slots, self.motions,
+                                                                      strict=True)
+                               if k < self.fixed.size and self.fixed[k] == dof]
+        ld = self.loading
+        self.elements = Elements(mesh.L0, mesh.EA, mesh.w,
+                                 PointLoads(ld.internal_ptr, ld.internal_s,
+                                            ld.internal_force.copy()))
+        self._t_internal: float | None = None if ld.internal_timed else 0.0
+        self.edofs = (3 * mesh.conn[:, :, None] + np.arange(3)).reshape(-1, 6)  # (n_elem, 6)
+        self.pattern = Pattern(self.edofs, self.n_dof)
+        self.gauss_s, self.gauss_w = mesh.gauss()
+        self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
+                                + ld.mass_value.sum())
+
+    # -------------------------------------------------------------------------------- loads
+    def set_time(self, t: float) -> None:
+        """Update loads inside elements that vary with time (no-op when none do)."""
+        if self._t_internal == t or not self.loading.internal_timed:
+            return
+        f = self.loading.internal_force.copy()
+        for tf, arr in self.loading.internal_timed:
+            f += tf(t) * arr
+        self.elements.set_load_forces(f)
+        self._t_internal = t
+
+    def nodal_load(self, t: float) -> np.ndarray:
+        """External forces applied at nodes, (n_dof,) N."""
+        p = self.loading.node_force.copy()
+        for tf, arr in self.loading.node_timed:
+            p += tf(t) * arr
+        return p.ravel()
+
+    def support_values(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Prescribed displacement, velocity and acceleration of the fixed dofs, (n_fixed,)."""
+        nf = self.fixed.size
+        u, v, a = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+        for k, tf in self._fixed_motions:
+            u[k], v[k], a[k] = tf.evaluate(t)
+        return u, v, a
+
+    def breakpoints(self, t0: float, t1: float, rel: float = 1e-10) -> list[tuple[float, float]]:
+        """Where a support motion or a load has a kink or a jump, in (t0, t1]: a sorted list of
+        (t_before, t_at). Breakpoints closer than ``rel`` (relative to max(1, |t|)) are one
+        group, at its last time t_at; t_before is just below its first (so that a velocity
+        jump is the sum of all the group's jumps). Groups within ``rel`` of t0 belong to the
+        previous step, which applies them at its end; one within ``rel`` of t1 is at t1."""
+        funcs = [tf for _, tf in self.motions]
+        funcs += [tf for tf, _ in self.loading.node_timed]
+        funcs += [tf for tf, _ in self.loading.internal_timed]
+        times = sorted({float(b) for tf in funcs for b in tf.breakpoints()})
+        groups: list[list[float]] = []
+        for b in times:
+            if groups and b - groups[-1][-1] <= rel * max(1.0, abs(b)):
+                groups[-1].append(b)
+            else:
+                groups.append([b])
+        out = []
+        for g in groups:
+            first, last = g[0], g[-1]
+            if last <= t0 + rel * max(1.0, abs(t0)) or first > t1 + rel * max(1.0, abs(t1)):
+                continue
+            at = t1 if last >= t1 - rel * max(1.0, abs(t1)) else last
+            out.append((float(np.nextafter(first, -np.inf)), at))
+        return out
+
+    def support_positions(self, t: float) -> np.ndarray:
+        """Positions of the fixed dofs at time t: case position + motion, (n_fixed,)."""
+        return self.mesh.X0.ravel()[self.fixed] + self.support_values(t)[0]
+
+    @property
+    def has_internal_loads(self) -> bool:
+        return self.loading.internal_s.size > 0
+
+    # -------------------------------------------------------------------------- element state
+    def chords(self, X: np.ndarray) -> np.ndarray:
+        """(n_elem, 3) chords x_j - x_i from node positions X (n_nodes, 3)."""
+        return X[self.mesh.conn[:, 1]] - X[self.mesh.conn[:, 0]]
+
+    def element_state(self, X: np.ndarray, h0: np.ndarray | None = None) -> ElementState:
+        return self.elements.solve(self.chords(X), h0)
+
+    def internal_force(self, state: ElementState) -> np.ndarray:
+        """Σ_e r_e: forces the nodes supply to hold the elements, (n_dof,) N (docs/theory.md §4)."""
+        r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
+        return np.bincount(self.edofs.ravel(), weights=r.reshape(-1),
+                           minlength=self.n_dof)
+
+    def element_lambda2(self, state: ElementState, X: np.ndarray) -> np.ndarray:
+        """Irvine's λ² of each element from its stiffness along the chord, (n_elem,).
+
+        Ernst's equivalent modulus, EA_eq = EA / (1 + λ²/12), read backwards: λ² = 12
+        (EA / (L0 k_cc) - 1) with k_cc = ĉᵀ K ĉ. λ² ≪ 1: the element takes a change of chord by
+        stretch (a bar); λ² ≫ 1: by sag (inf for a slack element, K = 0).
+        """
+        c = self.chords(X)
+        n = np.linalg.norm(c, axis=1)
+        u = c / np.where(n > 0, n, 1.0)[:, None]
+        kcc = np.einsum("ei,eij,ej->e", u, state.K, u)
+        with np.errstate(divide="ignore"):
+            ratio = np.where(kcc > 0, self.mesh.EA / (self.mesh.L0 * np.maximum(kcc, 1e-300)),
+                             np.inf)
+        return np.maximum(12.0 * (ratio - 1.0), 0.0)
+
+    def stiffness_data(self, state: ElementState) -> np.ndarray:
+        """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``)."""
+        return self.pattern.assemble(state.stiffness6)
+
+    def stiffness(self, state: ElementState) -> sp.csr_matrix:
+        return self.pattern.matrix(self.stiffness_data(state))
+
+    # ------------------------------------------------------------------------------- mass
+    def element_mass(self, state: ElementState) -> np.ndarray:
+        """Consistent element matrices Σ_g m L0 w_g NᵀN + point masses, (n_elem, 6, 6).
+
+        docs/theory.md §7. The compiled quadrature that the transient step also uses
+        (Elements.solve_dynamic).
+        With ``mass_model = "linear"`` the constant matrices of straight-line interpolation.
+        """
+        if self.mass_model == "linear":
+            return self.linear_element_mass()
+        ld = self.loading
+        me = self.elements.element_masses(state, self.gauss_s, self.gauss_w, self.mesh.m,
+                                          (ld.mass_elem, ld.mass_s, ld.mass_value))
+        if self.mass_model == "blended":
+            me *= 1.0 - self.lumped_fraction
+        return me
+
+    def diagonal_mass(self, per_length: np.ndarray | None = None) -> np.ndarray:
+        """The diagonal part of the mass matrix (of damping with ``per_length``), (n_dof,):
+        nodal masses, plus μ times the lumped element masses (μ = 1 lumped, 1/2 blended, 0
+        consistent and linear)."""
+        mu = self.lumped_fraction
+        node = (np.zeros(self.n_dof) if per_length is not None
+                else np.repeat(self.loading.node_mass, 3))
+        if mu == 0.0:
+            return node
+        return node + mu * (self.lumped_mass_diag(per_length) - (
+            node if per_length is None else 0.0))
+
+    def linear_element_mass(self, damping: bool = False) -> np.ndarray:
+        """Element matrices of straight-line interpolation N = [(1-ξ) I, ξ I], (n_elem, 6, 6).
+
+        m L0 / 6 [[2, 1], [1, 2]] ⊗ I per element, plus m_p N(ξ_p)ᵀ N(ξ_p) for point masses
+        inside elements; with ``damping`` the same for the material damping per length (point
+        masses carry none). The interior of an element moves with its chord, not with its
+        static catenary shape: the element carries axial waves as a bar does, and the matrix
+        does not depend on q (computed once per model).
+        """
+        cache = self.__dict__.setdefault("_linear_mass_cache", {})
+        if damping in cache:
+            return cache[damping]
+        mesh = self.mesh
+        q = mesh.c if damping else mesh.m
+        base = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
+        blocks = (q * mesh.L0)[:, None, None] * base[None]  # (n, 2, 2)
+        ld = self.loading
+        if not damping and ld.mass_value.size:
+            xi = ld.mass_s / mesh.L0[ld.mass_elem]
+            nn = np.stack([1.0 - xi, xi], axis=1)  # (p, 2)
+            np.add.at(blocks, ld.mass_elem, ld.mass_value[:, None, None]
+                      * nn[:, :, None] * nn[:, None, :])
+        out = np.kron(blocks, np.eye(3)[None])  # (n, 6, 6): node-major blocks of 3
+        cache[damping] = out
+        return out
+
+    def dynamic_state(self, X: np.ndarray, h0: np.ndarray | None, material_damping: bool,
+                      gradient: bool = False):
+        """Element state with element mass (and material damping) matrices in one pass.
+
+        Returns (state, M_e (n_elem, 6, 6) or None when the mass is lumped, C_e or None,
+        ∂M_e/∂c_k (n_elem, 3, 6, 6) or None): the gradient (analytic, of the consistent part)
+        with ``gradient`` and a consistent or blended mass only.
+        """
+        mesh = self.mesh
+        ld = self.loading
+        if self.mass_model == "linear":
+            state = self.elements.solve(self.chords(X), h0)
+            ce = self.linear_element_mass(damping=True) if material_damping else None
+            return state, self.linear_element_mass(), ce, None
+        gradient = gradient and self.mass_model in ("consistent", "blended")
+        out = self.elements.solve_dynamic(
+            self.chords(X), h0, self.gauss_s, self.gauss_w, mesh.m,
+            mesh.c if material_damping and self.mass_model in ("consistent", "blended")
+            else None, (ld.mass_elem, ld.mass_s, ld.mass_value), gradient=gradient)
+        state, me, ce = out[:3]
+        dm = out[3] if gradient else None
+        if self.mass_model == "lumped":
+            me = None
+        elif self.mass_model == "blended":
+            keep = 1.0 - self.lumped_fraction
+            me *= keep
+            if ce is not None:
+                ce *= keep
+            if dm is not None:
+                dm *= keep
+        return state, me, ce, dm
+
+    def lumped_mass_diag(self, per_length: np.ndarray | None = None) -> np.ndarray:
+        """Lumped diagonal on the dofs: half of each element at each end, (n_dof,).
+
+        Default: masses (kg), with point masses split by arc length and nodal masses added.
+        With ``per_length`` (e.g. material damping per length): that quantity alone.
+        """
+        mesh = self.mesh
+        q = mesh.m if per_length is None else per_length
+        node = np.zeros(mesh.n_nodes)
+        np.add.at(node, mesh.conn.ravel(), np.repeat(0.5 * q * mesh.L0, 2))
+        ld = self.loading
+        if per_length is None:
+            if ld.mass_value.size:
+                frac = ld.mass_s / mesh.L0[ld.mass_elem]
+                np.add.at(node, mesh.conn[ld.mass_elem, 0], (1 - frac) * ld.mass_value)
+                np.add.at(node, mesh.conn[ld.mass_elem, 1], frac * ld.mass_value)
+            node += ld.node_mass
+        return np.repeat(node, 3)
+
+    def mass_data(self, state: ElementState) -> np.ndarray:
+        """CSR data of the mass matrix M(q) on the full dof set."""
+        if self.mass_model == "lumped":
+            return self.pattern.assemble(None, self.lumped_mass_diag())
+        return self.pattern.assemble(self.element_mass(state), self.diagonal_mass())
+
+    def mass(self, state: ElementState) -> sp.csr_matrix:
+        return self.pattern.matrix(self.mass_data(state))
+
+    # ------------------------------------------------------------------------- reporting
+    def reactions(self, state: ElementState, t: float) -> np.ndarray:
+        """Force the supports exert on the cable, (n_nodes, 3) N; NaN on free axes.
+
+        Node equilibrium: support force + external load = Σ resisting forces. Inertia of point
+        masses sitting on a support node is not included (the support carries it directly).
+        """
+        r = self.internal_force(state) - self.nodal_load(t)
+        out = np.full(self.n_dof, np.nan)
+        out[self.fixed] = r[self.fixed]
+        return out.reshape(-1, 3)
+
+    def tensions(self, state: ElementState) -> np.ndarray:
+        """Tension at ends i and j of every element, (n_elem, 2) N."""
+        return self.elements.end_tensions(state.h)
+
+    def cable_summary(self, X: np.ndarray, state: ElementState) -> dict[str, np.ndarray]:
+        """Per cable: tension at its two ends, horizontal tension at its first end, sag, and
+        unstrained length (at the reference temperature).
+
+        Sag is the largest vertical distance from the chord to the cable (sampled on the exact
+        curve of every element); for a vertical chord, the largest distance from the chord.
+        """
+        mesh = self.mesh
+        nc = len(mesh.cable_names)
+        end_t = np.zeros((nc, 2))
+        h_t = np.zeros(nc)
+        sag = np.zeros(nc)
+        tens = self.tensions(state)
+        s = np.linspace(0.0, 1.0, 17)[None, :] * mesh.L0[:, None]  # (n_elem, 17)
+        pts = X[mesh.conn[:, 0]][:, None, :] + self.elements.position(state.h, s)
+        for ci in range(nc):
+            els = np.flatnonzero(mesh.cable_of_element == ci)
+            end_t[ci] = tens[els[0], 0], tens[els[-1], 1]
+            h_t[ci] = float(np.hypot(*state.h[els[0], :2]))
+            a = X[mesh.conn[els[0], 0]]
+            b = X[mesh.conn[els[-1], 1]]
+            p = pts[els].reshape(-1, 3) - a
+            c = b - a
+            ch = np.hypot(c[0], c[1])
+            if ch > 1e-9 * np.linalg.norm(c):
+                def dist(pts_rel, c=c, ch=ch):
+                    return (pts_rel[..., :2] @ c[:2]) / ch**2 * c[2] - pts_rel[..., 2]
+            else:
+                def dist(pts_rel, c=c):
+                    u = c / np.linalg.norm(c)
+                    return np.linalg.norm(pts_rel - np.multiply.outer(pts_rel @ u, u), axis=-1)
+            d = dist(p)
+            k = int(np.argmax(d))
+            # refine the sampled maximum on the exact curve: within one sample of it, which
+            # at an element end reaches into the neighbouring element
+            n_s = s.shape[1]
+            m, j = divmod(k, n_s)
+            spans = [(m, s[els[m], max(j - 1, 0)], s[els[m], min(j + 1, n_s - 1)])]
+            if j == 0 and m > 0:
+                spans.append((m - 1, s[els[m - 1], n_s - 2], s[els[m - 1], n_s - 1]))
+            if j == n_s - 1 and m < len(els) - 1:
+                spans.append((m + 1, s[els[m + 1], 0], s[els[m + 1], 1]))
+            best_sag = float(d[k])
+            for m_, lo, hi in spans:
+                e = int(els[m_])
+                xi = X[mesh.conn[e, 0]] - a
+
+                def neg(sv, e=e, xi=xi, dist=dist):
+                    q = np.zeros((mesh.n_elements, 1))
+                    q[e, 0] = sv
+                    return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
+
+                from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
+
+                best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                                       options={"xatol": 1e-10 * mesh.L0[e]})
+                best_sag = max(best_sag, -float(best.fun))
+            sag[ci] = best_sag
+        unstrained = np.bincount(mesh.cable_of_element, weights=mesh.L0 / mesh.thermal,
+                                 minlength=nc)
+        return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag,
+                "unstrained_length": unstrained}

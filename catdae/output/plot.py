@@ -1,0 +1,270 @@
+"""Figures of a results tree (matplotlib, Agg): what an engineer looks at first.
+
+Each function takes a step's group (an ``xarray.Dataset``, or a DataTree node) and returns a
+``matplotlib.figure.Figure``; axes are labelled from the variables' ``long_name`` and ``units``.
+The figures are made without pyplot (``Figure`` objects, saved through the Agg canvas): no
+window, no global state, and a notebook's own backend is left alone.
+
+- :func:`profile`: the cable's shape at chosen times, elevation (x-z) and plan (x-y);
+- :func:`history`: a node's displacement over time, per axis;
+- :func:`spectrum`: the amplitude spectrum of that displacement;
+- :func:`tension`: tension along each cable (at chosen times) and at the supports over time;
+- :func:`modes`: mode shapes, elevation and plan, with their frequencies.
+
+Lines are drawn through the nodes of each cable in order along it (``element_node``), so a
+node shared by several cables appears on each. ``catdae plot RESULT.nc -o FOLDER`` writes
+them as PNG files (:func:`write_all`).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from catdae._xr import xr
+from catdae.errors import CatdaeError
+
+WHAT = ("profile", "history", "spectrum", "tension", "modes")
+
+
+class PlotError(CatdaeError):
+    """A figure that the data cannot make (no such node, step or time)."""
+
+
+def label(var: xr.DataArray, name: str | None = None) -> str:
+    """'long_name [units]' from the variable's attributes (time: 's')."""
+    text = name or var.attrs.get("long_name", var.name)
+    units = var.attrs.get("units")
+    if units and " since " in str(units):
+        units = str(units).split(" since ")[0].replace("seconds", "s")
+    return f"{text} [{units}]" if units else str(text)
+
+
+def _subplots(*args, figsize, **kwargs):
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(*args, **kwargs)
+
+
+def _ds(data) -> xr.Dataset:
+    return data.to_dataset() if isinstance(data, xr.DataTree) else data
+
+
+def cable_paths(ds: xr.Dataset) -> dict[str, list[str]]:
+    """Node labels of each cable from its first end to its last (from element_node)."""
+    paths = {}
+    for cab in dict.fromkeys(str(c) for c in ds.element_cable.values):
+        nodes = ds.element_node.values[ds.element_cable.values == cab]  # (n, 2), in order
+        paths[cab] = [str(n) for n in nodes[:, 0]] + [str(nodes[-1, 1])]
+    return paths
+
+
+def _paths(ds: xr.Dataset) -> dict[str, list[str]]:
+    if "element_node" in ds.coords:
+        return cable_paths(ds)
+    # a modal group has no elements: each cable's own nodes, in order (its shared ends aside)
+    cab = ds.node_cable.values
+    return {str(c): [str(n) for n in ds.node.values[cab == c]] for c in dict.fromkeys(cab)
+            if c}
+
+
+def _times(ds: xr.Dataset, times) -> np.ndarray:
+    """The stored times nearest to the requested ones (default: 5 spread over the step)."""
+    t = ds.time.values
+    if times is None:
+        return t[np.unique(np.linspace(0, t.size - 1, min(5, t.size)).round().astype(int))]
+    return np.array([t[np.abs(t - float(x)).argmin()] for x in np.atleast_1d(times)])
+
+
+def profile(data, times=None, what: str = "position") -> Figure:
+    """The cable at the given times (nearest stored ones; static: its one state): elevation
+    (x-z) above, plan (x-y) below."""
+    ds = _ds(data)
+    var = ds[what]
+    fig, (ax_e, ax_p) = _subplots(2, 1, figsize=(8, 7), sharex=True)
+    states = [(None, var)] if "time" not in var.dims else [
+        (t, var.sel(time=t)) for t in _times(ds, times)]
+    paths = _paths(ds)
+    for t, x in states:
+        for k, (cab, nodes) in enumerate(paths.items()):
+            pts = x.sel(node=nodes)
+            tag = cab if t is None else f"{cab}, t = {t:.4g} s"
+            lab = tag if (k == 0 or len(paths) > 1) else None
+            line, = ax_e.plot(pts.sel(axis="x"), pts.sel(axis="z"), marker=".", label=lab,
+                              gid=f"{cab}|{t}")
+            ax_p.plot(pts.sel(axis="x"), pts.sel(axis="y"), marker=".", color=line.get_color(),
+                      gid=f"{cab}|{t}")
+    name = var.attrs.get("long_name", what)
+    ax_e.set_ylabel(label(var, f"{name}, z"))
+    ax_p.set_ylabel(label(var, f"{name}, y"))
+    ax_p.set_xlabel(label(var, f"{name}, x"))
+    ax_e.set_title("elevation")
+    ax_p.set_title("plan")
+    ax_e.legend(fontsize="small")
+    for ax in (ax_e, ax_p):
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(ds.attrs.get("title", ""))
+    fig.tight_layout()
+    return fig
+
+
+def _node(ds: xr.Dataset, node: str | None) -> str:
+    if node is None:  # the free node that moves most
+        free = ds.reaction.isnull().all([d for d in ds.reaction.dims if d != "node"])
+        d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
+            else ds.displacement
+        return str(np.sqrt((d**2).sum("axis")).max("time").idxmax("node").values)
+    if node not in ds.node.values:
+        raise PlotError(f"no node {node!r} in the results (e.g. {ds.node.values[0]!r})")
+    return node
+
+
+def history(data, node: str | None = None) -> Figure:
+    """Displacement of a node over time, one panel per axis (default node: the free node that
+    moves most)."""
+    ds = _ds(data)
+    node = _node(ds, node)
+    d = ds.displacement.sel(node=node)
+    fig, axes = _subplots(3, 1, figsize=(8, 7), sharex=True)
+    for ax, a in zip(axes, ds.axis.values, strict=True):
+        ax.plot(ds.time.values, d.sel(axis=a).values, gid=f"{node}|{a}")
+        ax.set_ylabel(label(ds.displacement, f"{a}"))
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel(label(ds.time, "time"))
+    fig.suptitle(f"{ds.displacement.attrs.get('long_name', 'displacement')}, node {node}")
+    fig.tight_layout()
+    return fig
+
+
+def amplitude_spectrum(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided amplitude spectrum of x(t) on a uniform grid, mean removed, Hann window
+    (amplitude-corrected): a sine of amplitude a between bins shows a peak close to a."""
+    dt = float(np.median(np.diff(t)))
+    n = t.size
+    w = np.hanning(n)
+    X = np.fft.rfft((x - x.mean()) * w)
+    amp = 2.0 * np.abs(X) / w.sum()
+    return np.fft.rfftfreq(n, dt), amp
+
+
+def spectrum(data, node: str | None = None) -> Figure:
+    """Amplitude spectrum of a node's displacement, per axis (log scale)."""
+    ds = _ds(data)
+    node = _node(ds, node)
+    t = ds.time.values
+    if t.size < 4 or not np.allclose(np.diff(t), np.diff(t)[0], rtol=1e-6, atol=1e-12):
+        raise PlotError("a spectrum needs at least 4 outputs at a constant interval")
+    fig, ax = _subplots(figsize=(8, 4.5))
+    for a in ds.axis.values:
+        f, amp = amplitude_spectrum(t, ds.displacement.sel(node=node, axis=a).values)
+        ax.semilogy(f[1:], np.maximum(amp[1:], 1e-30), label=str(a), gid=f"{node}|{a}")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel(label(ds.displacement, "amplitude"))
+    ax.set_title(f"spectrum of the displacement of node {node}")
+    ax.legend()
+    ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def tension(data, times=None) -> Figure:
+    """Tension along each cable (element ends at their arc length s; transient: at chosen
+    times) and, for a transient, the force on the cable at each support over time."""
+    ds = _ds(data)
+    transient = "time" in ds.tension.dims
+    fig, axes = _subplots(2 if transient else 1, 1, figsize=(8, 7 if transient else 4))
+    ax_s = axes[0] if transient else axes
+    states = [(t, ds.tension.sel(time=t)) for t in _times(ds, times)] if transient else [
+        (None, ds.tension)]
+    for t, tens in states:
+        for cab in dict.fromkeys(str(c) for c in ds.element_cable.values):
+            sel = ds.element_cable.values == cab
+            s = ds.element_s.values[sel].ravel()  # i, j of each element in turn
+            v = tens.values[sel].ravel()
+            tag = cab if t is None else f"{cab}, t = {t:.4g} s"
+            ax_s.plot(s, v, marker=".", label=tag, gid=f"{cab}|{t}")
+    ax_s.set_xlabel(label(ds.element_s, "unstrained arc length s"))
+    ax_s.set_ylabel(label(ds.tension))
+    ax_s.set_title("tension along the cable")
+    ax_s.legend(fontsize="small")
+    ax_s.grid(True, alpha=0.3)
+    if transient:
+        ax_t = axes[1]
+        sup = ~ds.reaction.isnull().all(("time", "axis"))
+        for n in ds.node.values[sup.values]:
+            r = ds.reaction.sel(node=n).fillna(0.0)
+            mag = np.sqrt((r**2).sum("axis"))
+            ax_t.plot(ds.time.values, mag.values, label=str(n), gid=f"{n}")
+        ax_t.set_xlabel(label(ds.time, "time"))
+        ax_t.set_ylabel(label(ds.reaction, "force at the support |R|"))
+        ax_t.set_title("at the supports")
+        ax_t.legend(fontsize="small")
+        ax_t.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def modes(data, n: int = 6) -> Figure:
+    """The first n mode shapes: elevation (x-z components against x) and plan (y), each
+    titled with its frequency."""
+    ds = _ds(data)
+    n = min(n, ds.mode.size)
+    fig, axes = _subplots(n, 1, figsize=(8, 1.9 * n + 0.6), sharex=True, squeeze=False)
+    paths = _paths(ds)
+    x_of = ds.reference_position.sel(axis="x") if "reference_position" in ds else None
+    for k, ax in enumerate(axes[:, 0]):
+        sh = ds["shape"].isel(mode=k)
+        mode = int(ds.mode.values[k])
+        for cab, nodes in paths.items():
+            x = x_of.sel(node=nodes).values if x_of is not None else ds.s.sel(node=nodes).values
+            for a, style in (("y", "--"), ("z", "-")):
+                ax.plot(x, sh.sel(node=nodes, axis=a).values, style, marker=".",
+                        label=f"{cab} {a}", gid=f"{mode}|{cab}|{a}")
+        extra = ", ".join(str(ds[v].values[k]) for v in ("plane", "symmetry") if v in ds)
+        ax.set_title(f"mode {mode}: {float(ds.frequency.values[k]):.4g} "
+                     f"{ds.frequency.attrs.get('units', '')}" + (f" ({extra})" if extra else ""),
+                     fontsize="medium")
+        ax.set_ylabel(label(ds["shape"], "shape"))
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize="small", ncol=2)
+    axes[-1, 0].set_xlabel(label(x_of, "x") if x_of is not None else label(ds.s, "s"))
+    fig.tight_layout()
+    return fig
+
+
+def _figure(what: str, ds: xr.Dataset, node, times) -> Figure:
+    if what in ("history", "spectrum"):
+        return history(ds, node) if what == "history" else spectrum(ds, node)
+    if what in ("profile", "tension"):
+        return profile(ds, times) if what == "profile" else tension(ds, times)
+    return modes(ds)
+
+
+def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=None,
+              node: str | None = None, times=None) -> list[Path]:
+    """PNG files ``<step>-<what>.png`` into ``folder`` for every figure that each step's kind
+    can make (profile, tension: all; history, spectrum: transient; modes: modal)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    names = list(tree.children) if not steps else list(steps)
+    unknown = [s for s in names if s not in tree.children]
+    if unknown:
+        raise PlotError(f"no step {unknown[0]!r} in the results (steps: "
+                        f"{', '.join(tree.children)})")
+    wanted = tuple(what) if what else WHAT
+    written = []
+    for name in names:
+        ds = tree[name].to_dataset()
+        kind = ds.attrs.get("kind")
+        can = {"static": ("profile", "tension"), "modal": ("modes",),
+               "transient": ("profile", "history", "spectrum", "tension")}.get(kind, ())
+        for w in wanted:
+            if w not in can:
+                continue
+            fig = _figure(w, ds, node, times)
+            path = folder / f"{name}-{w}.png"
+            fig.savefig(path, dpi=120)
+            written.append(path)
+    return written

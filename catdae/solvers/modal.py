@@ -1,0 +1,127 @@
+"""Natural frequencies and mode shapes about a static state (docs/theory.md §6-7).
+
+K_t φ = ω² M φ on the free dofs, with the tangent stiffness and the consistent (or lumped) mass
+of the catenary interpolation functions at the current configuration. Small models use LAPACK's
+dense symmetric-definite solver; larger ones sparse shift-invert Lanczos about zero (the cable
+is stable, so K_t is positive definite and the lowest modes are nearest to zero).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse.linalg as spla
+
+from catdae.element.elements import ElementState
+from catdae.errors import ConvergenceError
+from catdae.model.assembly import Model
+
+DENSE_LIMIT = 600  # free dofs up to which the dense solver is used
+
+
+@dataclass
+class ModalSolution:
+    frequency: np.ndarray  # (n_modes,) Hz
+    shape: np.ndarray  # (n_modes, n_nodes, 3), largest component = 1 (sign: its max is +)
+    plane: list[str]
+    symmetry: list[str]
+    solver: str
+
+
+def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) -> ModalSolution:
+    """The n_modes lowest modes of the model linearised about positions X and element state."""
+    free = model.free
+    k = model.stiffness(state)[free][:, free]
+    m = model.mass(state)[free][:, free]
+    nf = free.size
+    n_modes = min(int(n_modes), nf)
+    if n_modes < 1:
+        raise ConvergenceError("modal step: the model has no free degree of freedom")
+    if nf <= DENSE_LIMIT or n_modes >= nf - 1:  # ARPACK needs n_modes < nf - 1
+        kd, md = k.toarray(), m.toarray()
+        try:
+            lam, vec = sla.eigh(kd, md, subset_by_index=[0, n_modes - 1])
+        except np.linalg.LinAlgError:  # M singular: massless dofs (a cable of zero mass)
+            lam, vec = _reciprocal(kd, md, n_modes)
+            n_modes = lam.size
+        solver = "dense"
+    else:
+        try:
+            lam, vec = spla.eigsh(k.tocsc(), n_modes, m.tocsc(), sigma=0.0, which="LM")
+        except (RuntimeError, spla.ArpackNoConvergence) as exc:
+            raise ConvergenceError(f"modal step: eigensolver failed ({exc})") from exc
+        order = np.argsort(lam)
+        lam, vec = lam[order], vec[:, order]
+        solver = "sparse shift-invert"
+    if np.any(lam <= 0.0):
+        raise ConvergenceError(
+            "modal step: the tangent stiffness is not positive definite about this state "
+            f"(smallest eigenvalue {lam.min():.3g}); the static state is not stable")
+    freq = np.sqrt(lam) / (2.0 * np.pi)
+    shapes = np.zeros((n_modes, model.n_dof))
+    shapes[:, free] = vec.T
+    shapes = shapes.reshape(n_modes, -1, 3)
+    for i in range(n_modes):
+        flat = shapes[i].ravel()
+        j = np.argmax(np.abs(flat))
+        shapes[i] /= flat[j]
+    plane, symmetry = classify(model, X, shapes)
+    return ModalSolution(freq, shapes, plane, symmetry, solver)
+
+
+def _reciprocal(k: np.ndarray, m: np.ndarray, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest modes when M is only semi-definite: M φ = μ K φ with μ = 1/ω² (K must be positive
+    definite, as it is about a stable state). Massless dofs give μ = 0 (infinite frequency) and
+    are left out, so fewer than n_modes modes may come back."""
+    try:
+        mu, vec = sla.eigh(m, k)
+    except np.linalg.LinAlgError as exc:
+        raise ConvergenceError(
+            "modal step: the mass matrix is singular and the tangent stiffness is not positive "
+            "definite about this state; the static state is not stable") from exc
+    finite = np.flatnonzero(mu > 1e-12 * max(mu.max(), 0.0))
+    if finite.size == 0:
+        raise ConvergenceError("modal step: the model has no mass on its free dofs")
+    sel = finite[np.argsort(-mu[finite])][:n_modes]
+    return 1.0 / mu[sel], vec[:, sel]
+
+
+def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str], list[str]]:
+    """Label the modes of a single-span cable: in-plane/out-of-plane, symmetric/antisymmetric.
+
+    The plane is the vertical plane through the chord; a mode is out-of-plane when most of its
+    nodal motion (sum of squares over the nodes) is normal to it. Symmetry is read from the
+    mirror image about midspan (node k <-> node n-k along the cable). Scenes with several
+    cables, or a vertical chord, are labelled "unclassified".
+    """
+    mesh = model.mesh
+    n = shapes.shape[0]
+    if len(mesh.cable_names) != 1:
+        return ["unclassified"] * n, ["unclassified"] * n
+    order = np.concatenate([mesh.conn[:, 0], mesh.conn[-1:, 1]])  # nodes along the cable
+    chord = X[order[-1]] - X[order[0]]
+    horiz = np.array([chord[0], chord[1], 0.0])
+    if np.linalg.norm(horiz) < 1e-9 * np.linalg.norm(chord):
+        return ["unclassified"] * n, ["unclassified"] * n
+    e1 = horiz / np.linalg.norm(horiz)  # along the span
+    e3 = np.array([0.0, 0.0, 1.0])
+    e2 = np.cross(e3, e1)  # normal to the cable plane
+    plane, sym = [], []
+    for i in range(n):
+        u = shapes[i, order]  # (n_along, 3)
+        out = u @ e2
+        a1 = u @ e1
+        a3 = u @ e3
+        in_plane = float(a1 @ a1 + a3 @ a3) >= float(out @ out)
+        plane.append("in-plane" if in_plane else "out-of-plane")
+        # mirror about midspan: along-span component changes sign, the others keep theirs
+        if in_plane:
+            s_part = np.sum((a3 + a3[::-1]) ** 2) + np.sum((a1 - a1[::-1]) ** 2)
+            a_part = np.sum((a3 - a3[::-1]) ** 2) + np.sum((a1 + a1[::-1]) ** 2)
+        else:
+            s_part = np.sum((out + out[::-1]) ** 2)
+            a_part = np.sum((out - out[::-1]) ** 2)
+        sym.append("symmetric" if s_part >= a_part else "antisymmetric")
+    return plane, sym

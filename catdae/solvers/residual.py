@@ -1,0 +1,443 @@
+"""The residual and iteration matrix of a transient step for SUNDIALS IDA (docs/theory.md §8).
+
+Unknowns y = [q, v] of the free dofs, interleaved per dof
+(q_k, v_k side by side) after a reverse Cuthill-McKee ordering of the free dofs, so that the
+iteration matrix of a single cable is narrowly banded. Residual:
+
+    r_q = q' - v
+    r_v = M(q) v' + C(q) v + F(q) - P(t)    (+ the support coupling terms M_fp a_p + C_fp v_p)
+
+M(q), C(q) and F(q) come from the current configuration at every residual evaluation: the
+element tensions are re-solved (warm-started) for the current chords, then the consistent mass
+of the interpolation functions is assembled. The iteration matrix is analytic:
+
+    J = [[c_j I, -I], [K_t(q), c_j M(q) + C(q)]]
+
+(the derivatives of M(q) v' and C(q) v with respect to q are left out; IDA only needs a good
+iteration matrix, docs/theory.md §8). A trial state where an element cannot be solved
+is answered with NaN in the residual, which IDA treats as recoverable: it retries with a smaller
+step. Output is interpolated by IDA at the output times without shortening its own steps.
+
+Inertia (``inertia`` of a transient step). The paper's form keeps M(q) v' alone. With a
+configuration-dependent M(q) that form is not derived from a kinetic energy: the power balance
+misses ½ vᵀ Ṁ v, and where M(q) oscillates fast (axial waves in a slack cable change the element
+sag, hence N(s) and M, at kHz) this pumps energy into the motion until it blows up (seen on the
+paper's example 2, gentle scene, within 3 s). The default ``inertia = "lagrangian"`` adds the
+velocity terms of Lagrange's equations for T = ½ vᵀ M(q) v:
+
+    r_v = M v' + Ṁ v - ∂T/∂q + C v + F - P,   Ṁ_e = Σ_k ∂M_e/∂c_k ċ_k
+
+where an element's M_e depends on the nodes only through its chord c = x_j - x_i, so
+∂T/∂u_j = -∂T/∂u_i = ½ v_eᵀ (∂M_e/∂c) v_e. ∂M_e/∂c is analytic (forward-mode differentiation of
+the segment formulas, in the element pass that builds M_e; docs/theory.md §7.6). The undamped
+semi-discrete system is then conservative: the total energy (kinetic + strain + gravity,
+recorded as ``energy_total``) drifts only by the integration error, which shrinks as the
+tolerance tightens (tests). ``"paper"`` reproduces the paper's equations for comparison; a
+lumped mass has no such terms.
+
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces, _sym_from_upper
+from catdae.element.residual_kernel import residual_pass
+from catdae.errors import SolverError
+from catdae.model.assembly import Model
+from catdae.output.transient import potential
+
+_S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    v = np.ascontiguousarray(a, float).view()
+    v.flags.writeable = False
+    return v
+
+
+class TransientProblem:
+    """Residual and iteration matrix of one transient step, with evaluation counters."""
+
+    def __init__(self, model: Model, step, X0: np.ndarray, h0: np.ndarray | None):
+        self.model = model
+        self.step = step
+        self.n_dof = model.n_dof
+        free = model.free
+        if free.size == 0:
+            raise SolverError("transient step: the model has no free degree of freedom "
+                              "(every node is supported)", termination="no free dof")
+        # --- ordering: reverse Cuthill-McKee on the free-free stiffness graph
+        pat = model.pattern
+        full = sp.csr_matrix((np.ones(pat.nnz), pat.indices, pat.indptr),
+                             shape=(self.n_dof, self.n_dof))
+        ff = full[free][:, free]
+        perm = np.asarray(reverse_cuthill_mckee(ff.tocsr(), symmetric_mode=True), np.int64)
+        self.fidx = free[perm]  # full dof of unknown k
+        self.n = self.fidx.size
+        pos = np.full(self.n_dof, -1, np.int64)
+        pos[self.fidx] = np.arange(self.n)
+        rows = np.repeat(np.arange(self.n_dof), np.diff(pat.indptr))
+        cols = pat.indices.astype(np.int64)
+        keep = (pos[rows] >= 0) & (pos[cols] >= 0)
+        self.ff_sel = np.flatnonzero(keep)  # entries of the full CSR data in the ff block
+        self.ff_a = pos[rows[keep]]
+        self.ff_b = pos[cols[keep]]
+        self.bandwidth = int(np.abs(self.ff_a - self.ff_b).max(initial=0))
+        # --- sparse pattern of J (interleaved): rows 2a (q) and 2a+1 (v)
+        a, b = self.ff_a, self.ff_b
+        n = self.n
+        jr = np.concatenate([2 * np.arange(n), 2 * np.arange(n), 2 * a + 1, 2 * a + 1])
+        jc = np.concatenate([2 * np.arange(n), 2 * np.arange(n) + 1, 2 * b, 2 * b + 1])
+        keys = jc * (2 * n) + jr  # column-major for CSC
+        ukeys, inv = np.unique(keys, return_inverse=True)
+        self.j_nnz = ukeys.size
+        jcsc_rows = (ukeys % (2 * n)).astype(np.int32)
+        jcsc_cols = ukeys // (2 * n)
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(jcsc_cols, minlength=2 * n))])
+        self.j_pattern = sp.csc_matrix((np.ones(self.j_nnz), jcsc_rows, indptr),
+                                       shape=(2 * n, 2 * n))
+        m = a.size
+        self.jmap_qq = inv[:n]
+        self.jmap_qv = inv[n:2 * n]
+        self.jmap_vq = inv[2 * n:2 * n + m]
+        self.jmap_vv = inv[2 * n + m:]
+        # --- damping
+        self.damping = step.damping
+        self.alpha = self.beta = 0.0
+        if self.damping is not None and self.damping.kind == "rayleigh":
+            self.alpha, self.beta = self.damping.coefficients()
+        self.material = self.damping is not None and self.damping.kind == "material"
+        self.lagrangian = step.inertia == "lagrangian" and (
+            model.mass_model in ("consistent", "blended"))
+        nd = model.n_dof
+        self.m_diag = model.diagonal_mass()
+        self.c_diag = model.diagonal_mass(model.mesh.c) if self.material else np.zeros(nd)
+        # --- work arrays and state
+        self._wl0 = model.mesh.w * model.mesh.L0
+        self._dummy3 = np.zeros((1, 6, 6))
+        self._dummy4 = np.zeros((1, 3, 6, 6))
+        self._cache_t = None
+        self._cache_q = None
+        self._cache = None
+        self.X = np.array(X0, float).reshape(-1).copy()
+        self.h = None if h0 is None else np.array(h0, float, copy=True)
+        self._support_t = None
+        self.n_res = 0
+        self.n_jac = 0
+        # (t, largest |Δv_s| m/s, largest element λ²) of each support velocity jump
+        self.velocity_jumps: list[tuple[float, float, float]] = []
+        self.n_rejected = 0
+        self._fast_setup()
+
+    def _fast_setup(self) -> None:
+        """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
+        m = self.model
+        mm = m.mass_model
+        ne = m.mesh.n_elements
+        nd = self.n_dof
+        consistent = mm in ("consistent", "blended")
+        self._want_m = consistent
+        self._want_c = self.material and consistent
+        self._want_dm = self.lagrangian
+        self._scale = 1.0 - m.lumped_fraction if consistent else 1.0
+        self._use_m = mm != "lumped"
+        self._use_c = self.material and mm != "lumped"
+        self._me = (m.linear_element_mass() if mm == "linear" else
+                    np.zeros((ne, 6, 6)) if consistent else self._dummy3)
+        self._ce = (m.linear_element_mass(damping=True) if mm == "linear" and self.material else
+                    np.zeros((ne, 6, 6)) if self._want_c else self._dummy3)
+        self._dm = np.zeros((ne, 3, 6, 6)) if self._want_dm else self._dummy4
+        self._fflat = np.zeros((ne, 6))
+        self._kmat = np.zeros((ne, 3, 3))
+        self._its = np.zeros(ne, np.int64)
+        self._stat = np.zeros(ne, np.int64)
+        self._hw = np.zeros((ne, 3))
+        self._h_cold = np.zeros((ne, 3))
+        self._Xb = np.zeros(nd)
+        self._Vb = np.zeros(nd)
+        self._Ab = np.zeros(nd)
+        self._force = np.zeros(nd)
+        damped = self.damping is not None
+        self._v_diag = (self.c_diag + self.alpha * self.m_diag) if damped else np.zeros(nd)
+        self._buffers_at = None  # (t, q) whose element state the buffers hold
+        self._res_scratch = np.zeros(2 * self.n)
+        ld = m.loading
+        self._pm = m.elements._point_mass_csr((ld.mass_elem, ld.mass_s, ld.mass_value))
+        ld = m.loading
+        self._p_const = None if ld.node_timed else m.nodal_load(0.0)
+        self._fixed = np.ascontiguousarray(m.fixed, np.int64)
+        self._x0_fixed = m.mesh.X0.reshape(-1)[m.fixed]  # reference positions of fixed dofs
+        self._fidx = np.ascontiguousarray(self.fidx, np.int64)
+        self._conn = np.ascontiguousarray(m.mesh.conn, np.int64)
+        self._edofs = np.ascontiguousarray(m.edofs, np.int64)
+
+    def evaluate(self, t: float, y: np.ndarray, yp: np.ndarray, res: np.ndarray) -> bool:
+        """The residual at (t, y, yp) into ``res`` in one compiled pass; False (res untouched)
+        where an element cannot be solved. The element state stays in the buffers for the
+        iteration matrix and the outputs at the same (t, q)."""
+        m = self.model
+        xp, vp, ap = self._supports(t)
+        m.set_time(t)
+        el = m.elements
+        p = self._p_const if self._p_const is not None else m.nodal_load(t)
+        use_h = self.h is not None
+        ok = residual_pass(
+            y, yp, self._fidx, self._fixed, xp, vp, ap, self._conn, self._edofs, self._Xb,
+            self._Vb, self._Ab, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf, el._load_total,
+            self._wl0, self.h if use_h else self._h_cold, self._hw, use_h, 1e-12, 100,
+            m.gauss_s, m.gauss_w, m.mesh.m, m.mesh.c, *self._pm, self._want_m,
+            self._use_m, self._want_c, self._use_c, self._want_dm, self._scale, self.alpha,
+            self.beta, self.m_diag, self._v_diag, p, self._fflat, self._kmat, self._its,
+            self._stat, self._me, self._ce, self._dm, self._force, res)
+        if not ok:
+            self._buffers_at = None
+            return False
+        self.h = self._hw.copy()
+        self.X[:] = self._Xb
+        self._buffers_at = (t, np.array(y[0::2], copy=True))
+        return True
+
+    def _conf_from_buffers(self):
+        """(state, M_e, C_e, ∂M_e/∂c) of the last successful ``evaluate`` (copies)."""
+        state = ElementState(self.h, _sym_from_upper(self._fflat), self._kmat.copy(),
+                             self._its.copy(), self._stat.copy())
+        me = self._me.copy() if self._want_m else (self._me if self._use_m else None)
+        ce = self._ce.copy() if self._want_c else (self._ce if self._use_c else None)
+        dm = self._dm.copy() if self._want_dm else None
+        return state, me, ce, dm
+
+    # ------------------------------------------------------------------ pieces
+    def _supports(self, t: float):
+        if self._support_t != t:
+            m = self.model
+            u, v, a = m.support_values(t)
+            self._sup = (self._x0_fixed + u, v, a)
+            self._support_t = t
+        return self._sup
+
+    def configuration(self, t: float, q: np.ndarray):
+        """(state, M_e, C_e) for free positions q at time t, or None if an element fails.
+
+        The last evaluation is cached: IDA calls the iteration matrix at the state of the
+        residual it has just evaluated.
+        """
+        if self._cache_t == t and np.array_equal(self._cache_q, q):
+            return self._cache
+        at = self._buffers_at
+        if at is not None and at[0] == t and np.array_equal(at[1], q):
+            out = self._conf_from_buffers()
+            self._cache_t, self._cache_q, self._cache = t, at[1], out
+            return out
+        m = self.model
+        xp, _, _ = self._supports(t)
+        self.X[self.fidx] = q
+        self.X[m.fixed] = xp
+        m.set_time(t)
+        out = m.dynamic_state(self.X.reshape(-1, 3), self.h, self.material,
+                              gradient=self.lagrangian)
+        state = out[0]
+        if (state.status == NOT_CONVERGED).any() or not np.all(np.isfinite(state.h)):
+            out = None
+        else:
+            self.h = state.h
+        self._cache_t, self._cache_q, self._cache = t, np.array(q, copy=True), out
+        return out
+
+    def full_vectors(self, t: float, v: np.ndarray, vd: np.ndarray):
+        m = self.model
+        _, vp, ap = self._supports(t)
+        V = np.zeros(self.n_dof)
+        A = np.zeros(self.n_dof)
+        V[self.fidx] = v
+        A[self.fidx] = vd
+        V[m.fixed] = vp
+        A[m.fixed] = ap
+        return V, A
+
+    def dynamic_force(self, t, conf, V, A):
+        """M A + C V + g + F - P on the full dof set, (n_dof,) N (one compiled pass)."""
+        m = self.model
+        state, me, ce, dm = conf
+        el = m.elements
+        out = np.empty(self.n_dof)
+        damped = self.damping is not None
+        _dynamic_forces(m.edofs, state.h, el._load_total, self._wl0,
+                        me if me is not None else self._dummy3, me is not None,
+                        ce if ce is not None else self._dummy3, ce is not None, state.K,
+                        dm if dm is not None else self._dummy4, dm is not None,
+                        self.alpha if damped else 0.0, self.beta if damped else 0.0, V, A, out)
+        out += self.m_diag * A - m.nodal_load(t)
+        if damped:
+            out += (self.c_diag + self.alpha * self.m_diag) * V
+        return out
+
+    def blocks(self, conf, cj, V=None, A=None):
+        """CSR data (full dofs) of ∂r_v/∂q ≈ K_t and of ∂r_v/∂v + cj ∂r_v/∂v' ≈ cj M + C.
+
+        With the Lagrangian inertia terms (and V, A given) their first-order parts are added:
+        ∂(M a)/∂u = Σ_k (∂M/∂c_k a) S_k and ∂g/∂v = Σ_k ċ_k ∂M/∂c_k + Qᵀ S - Sᵀ Q, with
+        Q_k = ∂M/∂c_k v, S = ∂c/∂u_e = [-I, I] and g = Ṁ v - ∂T/∂q. The derivatives of ∂M/∂c
+        themselves are left out.
+        """
+        m = self.model
+        state, me, ce, dm = conf
+        k6 = state.stiffness6
+        vv = np.zeros_like(k6)
+        if me is not None:
+            vv += (cj + self.alpha) * me
+        if ce is not None:
+            vv += ce
+        if self.beta:
+            vv += self.beta * k6
+        if dm is not None and V is not None:
+            ed = m.edofs
+            v_e = V[ed]
+            a_e = A[ed]
+            cdot = v_e[:, 3:] - v_e[:, :3]
+            qv = (dm @ v_e[:, None, :, None])[..., 0]  # (n_elem, 3, 6)
+            qa = (dm @ a_e[:, None, :, None])[..., 0]
+            vv += np.einsum("ek,ekij->eij", cdot, dm)
+            vv += np.einsum("eki,kj->eij", qv, _S) - np.einsum("ki,ekj->eij", _S, qv)
+            k6 = k6 + np.einsum("eki,kj->eij", qa, _S)
+        diag = (cj + self.alpha) * self.m_diag + self.c_diag
+        return m.pattern.assemble(k6), m.pattern.assemble(vv, diag)
+
+    def mass_data(self, conf) -> np.ndarray:
+        """CSR data (full dofs) of M(q)."""
+        return self.model.pattern.assemble(conf[1], self.m_diag)
+
+    def ff(self, data: np.ndarray) -> sp.csr_matrix:
+        """Free-free block (in the unknowns' order) of full-dof CSR data."""
+        return sp.csr_matrix((data[self.ff_sel], (self.ff_a, self.ff_b)), shape=(self.n,) * 2)
+
+    # ------------------------------------------------------------------ IDA callbacks
+    def resfn(self, t, y, yp, res):
+        self.n_res += 1
+        try:
+            if not self.evaluate(t, y, yp, res):
+                self.n_rejected += 1
+                res[:] = np.nan
+        except (FloatingPointError, ValueError, ZeroDivisionError, np.linalg.LinAlgError):
+            self.n_rejected += 1
+            res[:] = np.nan
+
+    def _jac_parts(self, t, y, yp, cj):
+        conf = self.configuration(t, y[0::2])
+        if conf is None:
+            return None
+        V = A = None
+        if conf[3] is not None:
+            V, A = self.full_vectors(t, y[1::2], yp[1::2])
+        kdata, vdata = self.blocks(conf, cj, V, A)
+        sel = self.ff_sel
+        return kdata[sel], vdata[sel]
+
+    def jac_dense(self, t, y, yp, res, cj, JJ):
+        """Iteration matrix into the full (2n, 2n) array (dense and band solvers)."""
+        self.n_jac += 1
+        parts = self._jac_parts(t, y, yp, cj)
+        JJ[:, :] = 0.0
+        idx = np.arange(self.n)
+        JJ[2 * idx, 2 * idx] = cj
+        JJ[2 * idx, 2 * idx + 1] = -1.0
+        if parts is None:  # keep a usable matrix; the residual will reject the state
+            JJ[2 * idx + 1, 2 * idx + 1] = cj
+            return
+        kv, vv = parts
+        JJ[2 * self.ff_a + 1, 2 * self.ff_b] = kv
+        JJ[2 * self.ff_a + 1, 2 * self.ff_b + 1] = vv
+
+    def jac_sparse(self, t, y, yp, res, cj, JJ):
+        """Iteration matrix as the CSC data array of ``j_pattern`` (sparse solver)."""
+        self.n_jac += 1
+        parts = self._jac_parts(t, y, yp, cj)
+        data = np.zeros(self.j_nnz)
+        data[self.jmap_qq] = cj
+        data[self.jmap_qv] = -1.0
+        if parts is None:
+            data[self.jmap_vv[self.ff_a == self.ff_b]] = cj
+        else:
+            kv, vv = parts
+            np.add.at(data, self.jmap_vq, kv)
+            np.add.at(data, self.jmap_vv, vv)
+        JJ[:] = data
+
+    # ------------------------------------------------------------------ start and output
+    def initial(self, t0: float, X: np.ndarray, V: np.ndarray):
+        """Consistent y0, yp0 at the start, from the previous step's positions and velocities."""
+        vs_before = np.asarray(V, float).reshape(-1)[self.model.fixed]
+        return self._consistent(t0, X.reshape(-1)[self.fidx], V.reshape(-1)[self.fidx],
+                                vs_before, "transient start")
+
+    def restart(self, t: float, y: np.ndarray, t_before: float):
+        """Consistent y, yp just after a breakpoint of the prescribed motions or loads at t;
+        the support velocities before it are those at ``t_before``."""
+        vs_before = self.model.support_values(t_before)[1]
+        return self._consistent(t, y[0::2], y[1::2], vs_before, f"restart at t = {t:.6g} s")
+
+    def _consistent(self, t0, q0, v0, vs_before, where):
+        """y0, yp0 with v'(0) = M⁻¹ (P - C v - F - coupling) on the free dofs.
+
+        A prescribed support velocity that jumps at t0 (A = a sin ωt after a rest, the corner
+        of a linear ramp) acts through an impulsive reaction on the supports only: no impulse
+        reaches a free dof, so its generalised momentum p_f = M_ff v_f + M_fs v_s is
+        continuous and the free velocities jump by -M_ff⁻¹ M_fs Δv_s. (Keeping v_f instead
+        would apply an impulse -M_fs Δv_s to the free dofs; with the consistent catenary mass,
+        which amplifies chord motion in slack elements, that impulse grows with the mesh.)
+        With a lumped mass M_fs = 0 and nothing changes.
+        """
+        m = self.model
+        conf = self.configuration(t0, q0)
+        if conf is None:
+            raise SolverError(f"{where}: an element cannot be solved in the configuration",
+                              termination="initial state")
+        mdata = self.mass_data(conf)
+        mff = self.ff(mdata).tocsc()
+        vs_after = self._supports(t0)[1]
+        dvs = vs_after - vs_before
+        # a jump, not the round-off of two evaluations of a smooth motion
+        dvs[np.abs(dvs) <= 1e-12 * max(1.0, float(np.abs(vs_after).max(initial=0.0)))] = 0.0
+        if np.any(dvs):
+            lam2 = m.element_lambda2(conf[0], self.X.reshape(-1, 3))
+            self.velocity_jumps.append((float(t0), float(np.abs(dvs).max()),
+                                        float(lam2.max())))
+        v0 = np.array(v0, float)
+        if np.any(dvs) and m.mass_model != "lumped":
+            full = m.pattern.matrix(mdata)
+            v0 -= spla.spsolve(mff, full[self.fidx][:, m.fixed] @ dvs)
+        V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
+        f = self.dynamic_force(t0, conf, V_full, A_full)  # M_fp a_p + C v + F - P
+        a0 = spla.spsolve(mff, -f[self.fidx])
+        y0 = np.empty(2 * self.n)
+        yp0 = np.empty(2 * self.n)
+        y0[0::2], y0[1::2] = q0, v0
+        yp0[0::2], yp0[1::2] = v0, a0
+        return y0, yp0
+
+    def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
+        """Positions, velocities, accelerations, tensions, reactions and energies at t (one
+        compiled residual pass leaves the element state and forces in the buffers)."""
+        m = self.model
+        # read-only views, as IDA passes them: one compiled signature of the pass, not two
+        y, yp = _readonly(y), _readonly(yp)
+        if not self.evaluate(t, y, yp, self._res_scratch):
+            raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
+                              termination="element failure")
+        h = self.h  # a copy of the buffer, made by evaluate
+        X, V, A = self._Xb.copy(), self._Vb.copy(), self._Ab.copy()
+        p = self._p_const if self._p_const is not None else m.nodal_load(t)
+        f = self._force + self.m_diag * A + self._v_diag * V - p  # M A + C V + g + F - P
+        reaction = np.full(self.n_dof, np.nan)
+        reaction[m.fixed] = f[m.fixed]
+        kinetic = 0.5 * float(self.m_diag @ (V * V))
+        if self._use_m:
+            v_e = V[m.edofs]
+            kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
+        strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
+                (kinetic, strain, gravity))
+

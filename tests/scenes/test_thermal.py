@@ -1,0 +1,204 @@
+"""Temperature: ``thermal_expansion`` on a material, ``temperature_change`` on a step.
+
+The strain is ε = T/EA + α ΔT per unit of unstrained length; mass and weight per unit of
+unstrained length are unchanged. References, each derived here without catdae's element:
+- code_aster SSNL114 (heavy cable heated by 39.26 K): Irvine's closed form for a level span,
+  written with the thermal strain, solved by brentq;
+- a plumb line with a point load inside an element: z(s) = -∫ (1 + α ΔT + T(σ)/EA) dσ;
+- a weightless taut bar: T = EA (chord/L0 - 1 - α ΔT);
+- a taut string's frequencies k/(2l) sqrt(T l/(m L0)) in a modal step after heating;
+- the published result of OpenSees' two-cable CatenaryCable example with a thermal load.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import catdae
+from catdae.errors import CaseError
+
+from scene_toml import cable_scene, static_step
+
+# code_aster V6.02.114 (SSNL114): 2 l0 = 2 L = 325 m, A = 2.2783e-4 m², E = 5.7e10 Pa,
+# α = 2.3e-5 /K, ρ = 2844.23 kg/m³, g = 9.81; heated from 0 to 39.26 °C
+SSNL = dict(L=325.0, A=2.2783e-4, E=5.7e10, alpha=2.3e-5, rho=2844.23, g=9.81, dT=39.26)
+SSNL114_MIDSPAN = -8.195  # m, published, to 1e-3 (weight per heated length)
+
+
+def level_catenary_midspan(L0, EA, w, eps_t, span=None):
+    """(midspan height below the supports (< 0), H) of an elastic catenary of unstrained length
+    L0 between level supports ``span`` apart (default L0) with stretch 1 + eps_t + T/EA
+    (Irvine 1981, §2.2 with a thermal strain): span = H L0/EA + (1 + eps_t) (2H/w)
+    asinh(w L0/(2H)), z_mid = (1 + eps_t) (H - sqrt(H² + (w L0/2)²))/w - w L0²/(8 EA)."""
+    span = L0 if span is None else span
+
+    def gap(H):
+        return H * L0 / EA + (1.0 + eps_t) * 2.0 * H / w * math.asinh(w * L0 / (2.0 * H)) - span
+    H = brentq(gap, 1e-6 * w * L0, 1e3 * w * L0, xtol=1e-13, rtol=1e-15)
+    return ((1.0 + eps_t) * (H - math.hypot(H, 0.5 * w * L0)) / w
+            - w * L0**2 / (8.0 * EA)), H
+
+
+def ssnl114_text(elements=10):
+    p = SSNL
+    EA, m = p["E"] * p["A"], p["rho"] * p["A"]
+    return cable_scene(
+        B=(p["L"], 0.0, 0.0), L0=p["L"], EA=EA, mass=m, elements=elements,
+        steps=static_step("cold") + (f'[[steps]]\nkind = "static"\nname = "hot"\n'
+                                     f'temperature_change = {p["dT"]!r}\n'),
+    ).replace("[nodes]", f"thermal_expansion = {p['alpha']!r}\n[nodes]")
+
+
+def test_ssnl114_heavy_cable_heated():
+    p = SSNL
+    EA, w = p["E"] * p["A"], p["rho"] * p["A"] * p["g"]
+    tree = catdae.run(catdae.load_case(ssnl114_text()))
+    cold, H_cold = level_catenary_midspan(p["L"], EA, w, 0.0)
+    hot, H_hot = level_catenary_midspan(p["L"], EA, w, p["alpha"] * p["dT"])
+    z_cold = float(tree["cold"].ds.position.sel(node="c.5", axis="z"))
+    z_hot = float(tree["hot"].ds.position.sel(node="c.5", axis="z"))
+    assert z_cold == pytest.approx(cold, rel=1e-9)
+    assert z_hot == pytest.approx(hot, rel=1e-9)  # -8.19265 m
+    assert float(tree["hot"].ds.horizontal_tension[0]) == pytest.approx(H_hot, rel=1e-9)
+    assert float(tree["hot"].ds.unstrained_length[0]) == pytest.approx(p["L"], rel=1e-14)
+    # code_aster keeps the weight per heated length (w (1 + α ΔT) per unstrained length):
+    # that convention reproduces its published midspan, ours differs by the extra weight
+    aster, _ = level_catenary_midspan(p["L"], EA, w * (1 + p["alpha"] * p["dT"]),
+                                      p["alpha"] * p["dT"])
+    assert abs(aster - SSNL114_MIDSPAN) <= 1e-3
+
+
+def plumb_text(dT, alpha, s_load, gravity=None, M=50.0, P=30.0):
+    """A line from A (pinned) to B (free, started 2 m to the side so that no element starts
+    vertical and slack) with a point mass M at B and a downward load P on the cable at arc
+    length s_load: it hangs vertically below A."""
+    lines = cable_scene(B=(2.0, 0.0, -20.0), L0=20.0, EA=2e5, mass=1.2, elements=4,
+                        supports=("A",), gravity=gravity,
+                        extra=(f'[[point_masses]]\nname = "end"\nnode = "B"\nmass = {M!r}\n'
+                               f'[[loads]]\nname = "p"\ncable = "c"\ns = {s_load!r}\n'
+                               f"force = [0.0, 0.0, {-P!r}]\n"),
+                        steps=(f'[[steps]]\nkind = "static"\nname = "st"\n'
+                               f"temperature_change = {dT!r}\n"))
+    return lines.replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+
+
+def plumb_z(s, L0, EA, w, M, g, P, s_load, eps_t):
+    """z(s) of the plumb line: -∫_0^s (1 + eps_t + T(σ)/EA) dσ with
+    T(σ) = M g + w (L0 - σ) + P [σ < s_p]."""
+    def int_T(a, b):  # ∫_a^b T dσ
+        val = (M * g + w * L0) * (b - a) - 0.5 * w * (b * b - a * a)
+        return val + P * max(0.0, min(b, s_load) - a)
+    return -((1.0 + eps_t) * s + int_T(0.0, s) / EA)
+
+
+@pytest.mark.parametrize("dT", [0.0, 80.0, -40.0])
+def test_plumb_line_heated_with_a_load_inside_an_element(dT):
+    alpha, s_load, g = 1.5e-4, 7.3, 9.81  # s_load inside element 2 of 4 (5 m each)
+    tree = catdae.run(catdae.load_case(plumb_text(dT, alpha, s_load)))
+    ds = tree["st"].ds
+    args = (20.0, 2e5, 1.2 * g, 50.0, g, 30.0, s_load, alpha * dT)
+    for node, s in (("B", 20.0), ("c.1", 5.0), ("c.2", 10.0), ("c.3", 15.0)):
+        z = float(ds.position.sel(node=node, axis="z"))
+        assert z == pytest.approx(plumb_z(s, *args), rel=1e-12, abs=1e-12)
+        assert float(ds.position.sel(node=node, axis="x")) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_weightless_taut_bar_and_per_cable_temperature():
+    EA, L0, chord, alpha = 1e6, 9.9, 10.0, 1e-4
+    text = (
+        '[materials.m]\nEA = 1e6\nmass = 0.5\nweight = 0.0\nthermal_expansion = 1e-4\n'
+        '[nodes]\nA = [0.0, 0.0, 0.0]\nB = [10.0, 0.0, 0.0]\nC = [0.0, 5.0, 0.0]\n'
+        'D = [10.0, 5.0, 0.0]\n[supports]\nA = "pinned"\nB = "pinned"\nC = "pinned"\n'
+        'D = "pinned"\n'
+        '[[cables]]\nname = "hot"\nends = ["A", "B"]\nmaterial = "m"\nlength = 9.9\n'
+        '[[cables]]\nname = "cold"\nends = ["C", "D"]\nmaterial = "m"\nlength = 9.9\n'
+        '[[steps]]\nkind = "static"\nname = "st"\ntemperature_change = { hot = 50.0 }\n'
+    )
+    ds = catdae.run(catdae.load_case(text))["st"].ds
+    T = ds.cable_end_tension.sel(end="i").values
+    assert T[0] == pytest.approx(EA * (chord / L0 - 1.0 - alpha * 50.0), rel=1e-10)
+    assert T[1] == pytest.approx(EA * (chord / L0 - 1.0), rel=1e-10)
+
+
+def test_temperature_holds_in_the_modal_and_transient_steps_that_follow():
+    # a taut string: f_k = k/(2 l) sqrt(T l / (m L0)) with T = EA (l/L0 - 1 - α ΔT)
+    l, L0, EA, m, alpha, dT = 10.0, 9.99, 1e6, 0.2, 2e-5, 25.0
+    steps = (f'[[steps]]\nkind = "static"\nname = "hot"\ntemperature_change = {dT!r}\n'
+             '[[steps]]\nkind = "modal"\nname = "modes"\nmodes = 2\n'
+             '[[steps]]\nkind = "transient"\nname = "rest"\nduration = 0.05\n'
+             'output_interval = 0.01\nrtol = 1e-8\natol = 1e-10\n')
+    text = cable_scene(B=(l, 0.0, 0.0), L0=L0, EA=EA, mass=m, weight=0.0, elements=40,
+                       steps=steps).replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+    tree = catdae.run(catdae.load_case(text))
+    T = EA * (l / L0 - 1.0 - alpha * dT)
+    f1 = 1.0 / (2.0 * l) * math.sqrt(T * l / (m * L0))
+    f1_cold = 1.0 / (2.0 * l) * math.sqrt(EA * (l / L0 - 1.0) * l / (m * L0))
+    assert abs(f1 / f1_cold - 1.0) > 0.2  # the test can tell
+    assert float(tree["modes"].ds.frequency[0]) == pytest.approx(f1, rel=2e-3)
+    # the heated equilibrium stays at rest in the transient step (it would move if the
+    # transient step saw the cold cable)
+    assert float(np.abs(tree["rest"].ds.displacement.values
+                        - tree["hot"].ds.displacement.values[None]).max()) < 1e-9
+    assert float(tree["rest"].ds.tension.max()) == pytest.approx(T, rel=1e-8)
+
+
+@pytest.mark.parametrize(("value", "path", "fragment"), [
+    ('"hot"', "steps[0].temperature_change", "expected a temperature change in K"),
+    ("{ nope = 3.0 }", "steps[0].temperature_change.nope", "unknown cable 'nope'"),
+    ('{ c = "warm" }', "steps[0].temperature_change.c", "finite number"),
+])
+def test_bad_temperature_names_the_field(value, path, fragment):
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=1e6, mass=1.0,
+                       steps=f'[[steps]]\nkind = "static"\ntemperature_change = {value}\n')
+    with pytest.raises(CaseError) as err:
+        catdae.load_case(text)
+    found = dict(err.value.problems)
+    assert fragment in found[path]
+
+
+def test_bad_thermal_expansion_names_the_field():
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=1e6, mass=1.0).replace(
+        "[nodes]", 'thermal_expansion = "steel"\n[nodes]')
+    with pytest.raises(CaseError) as err:
+        catdae.load_case(text)
+    assert "expected a number" in dict(err.value.problems)["materials.m.thermal_expansion"]
+
+
+def test_opensees_two_cable_example_with_a_thermal_load():
+    # OpenSees CatenaryCable verification example (after Salehi Ahmad Abad et al. 2013): two
+    # 50 m cables from (0, 0, 90) to node 2 at (15, 0, 40) (free in x and z) to (30, 60, 30),
+    # E A = 3e7 N, a uniform load of 1 N per unstrained metre along -z, α = 6.5e-6 /K,
+    # ΔT = 100 K. Published: node 2 moves by (8.58693, 0, 2.82578) m.
+    text = (
+        "[materials.s]\nEA = 3.0e7\nmass = 0.1\nweight = 1.0\nthermal_expansion = 6.5e-6\n"
+        "[nodes]\nN1 = [0.0, 0.0, 90.0]\nN2 = [15.0, 0.0, 40.0]\nN3 = [30.0, 60.0, 30.0]\n"
+        '[supports]\nN1 = "pinned"\nN2 = ["y"]\nN3 = "pinned"\n'
+        '[[cables]]\nname = "a"\nends = ["N1", "N2"]\nmaterial = "s"\nlength = 50.0\n'
+        "elements = 4\n"
+        '[[cables]]\nname = "b"\nends = ["N2", "N3"]\nmaterial = "s"\nlength = 50.0\n'
+        "elements = 4\n"
+        '[[steps]]\nkind = "static"\nname = "hot"\ntemperature_change = 100.0\n'
+    )
+    ds = catdae.run(catdae.load_case(text))["hot"].ds
+    assert ds.displacement.sel(node="N2").values == pytest.approx([8.58693, 0.0, 2.82578],
+                                                                  abs=5e-6)
+
+
+def test_distributed_load_is_per_unstrained_metre_at_the_reference_temperature():
+    # heating lengthens the cable by 1 + α ΔT = 1.05; the loads it carries do not change:
+    # the supports take w L0 + q L0 along z and p L0 along y
+    L0, w, q, p, alpha, dT = 10.5, 1.2 * 9.81, 3.0, 2.0, 1e-3, 50.0
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=L0, EA=1e5, mass=1.2, elements=5,
+                       extra=('[[distributed_loads]]\ncable = "c"\n'
+                              f"load = [0.0, {p!r}, {-q!r}]\n"),
+                       steps=(f'[[steps]]\nkind = "static"\nname = "st"\n'
+                              f"temperature_change = {dT!r}\n"))
+    text = text.replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+    ds = catdae.run(catdae.load_case(text))["st"].ds
+    R = ds.reaction.sel(node=["A", "B"]).values.sum(axis=0)
+    assert R == pytest.approx([0.0, -p * L0, (w + q) * L0], abs=1e-9 * (w + q) * L0)
+    assert float(ds.unstrained_length[0]) == pytest.approx(L0, rel=1e-14)

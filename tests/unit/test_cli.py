@@ -1,0 +1,207 @@
+"""The command line (``catdae.cli``): exit codes, files written, one clear message on errors.
+
+Most commands run in-process through ``catdae.cli.main(argv)``; ``python -m catdae`` is run once
+as a subprocess to check the module entry point.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import catdae
+import catdae.analysis
+from catdae import ConvergenceError
+from catdae.cli import default_case_path, main
+
+from repo_paths import CASES  # noqa: E402
+
+THREE = CASES / "three_cables_shared_node.toml"
+
+BAD = """
+title = "bad"
+[materials.m]
+EA = -1.0
+mas = 3.0
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [10.0, 0.0, 0.0]
+[supports]
+A = "pinned"
+B = "pinned"
+[[cables]]
+name = "c"
+ends = ["A", "B"]
+material = "m"
+length = 11.0
+"""
+
+
+def test_run_writes_the_results(tmp_path, capsys):
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    assert f"results written to {out}" in stdout
+    assert "[equilibrium] static" in stdout and "[modes] modal" in stdout
+    tree = catdae.read_results(out)
+    assert list(tree.children) == ["equilibrium", "modes"]
+    assert tree.attrs["status"] == "completed"
+    assert tree.attrs["case_toml"] == THREE.read_text()
+
+
+def test_run_default_output_and_overrides(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", str(THREE), "--elements", "3"]) == 0
+    tree = catdae.read_results(tmp_path / "three_cables_shared_node.nc")
+    assert tree["equilibrium"].to_dataset().element.size == 9
+
+
+def test_mass_model_override(tmp_path, capsys):
+    """--mass-model sets the mass of modal (and transient) steps: the lumped mass bounds the
+    frequencies from below, the consistent mass from above."""
+    f = {}
+    for mm in ("consistent", "lumped"):
+        out = tmp_path / f"{mm}.nc"
+        assert main(["run", str(THREE), "--mass-model", mm, "-o", str(out)]) == 0
+        ds = catdae.read_results(out)["modes"].to_dataset()
+        assert ds.attrs["mass_model"] == mm
+        f[mm] = ds.frequency.values
+    assert np.all(f["lumped"] < f["consistent"])
+    with pytest.raises(SystemExit) as info:
+        main(["run", str(THREE), "--mass-model", "heavy"])
+    assert info.value.code == 2
+    assert "--mass-model" in capsys.readouterr().err
+
+
+def test_check_valid_case(capsys):
+    assert main(["check", str(THREE)]) == 0
+    out = capsys.readouterr().out
+    assert "valid" in out and "3 cable(s)" in out and "24 elements" in out
+
+
+def test_check_invalid_case_lists_every_problem(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(BAD)
+    assert main(["check", str(bad)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    err = captured.err
+    assert "Traceback" not in err
+    assert f"{bad}: materials.m.EA:" in err
+    assert f"{bad}: materials.m.mas: unknown key 'mas'; did you mean 'mass'?" in err
+    assert f"{bad}: materials.m.mass: missing" in err
+    # run refuses it the same way, before computing anything
+    assert main(["run", str(bad), "-o", str(tmp_path / "bad.nc")]) == 2
+    assert "materials.m.EA" in capsys.readouterr().err
+    assert not (tmp_path / "bad.nc").exists()
+
+
+@pytest.mark.parametrize("command", ["run", "check"])
+def test_missing_case_file_is_one_clear_line(tmp_path, capsys, command):
+    missing = tmp_path / "missing.toml"
+    assert main([command, str(missing)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert str(missing) in err and "cannot read the case file" in err
+
+
+def test_invalid_override_is_an_invalid_case(tmp_path, capsys):
+    assert main(["run", str(THREE), "--elements", "0", "-o", str(tmp_path / "x.nc")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "elements: expected an integer >= 1" in err
+
+
+def test_output_in_a_missing_directory(tmp_path, capsys):
+    out = tmp_path / "nowhere" / "x.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "nowhere" in err
+
+
+def test_failed_analysis_exits_1_and_says_where_the_results_are(tmp_path, monkeypatch, capsys):
+    def broken(*args, **kwargs):
+        raise ConvergenceError("static equilibrium not found (test)")
+
+    monkeypatch.setattr(catdae.analysis, "solve_static", broken)
+    out = tmp_path / "x.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "static equilibrium not found (test)" in err and str(out) in err
+    assert "failed in step 'equilibrium'" in catdae.read_results(out).attrs["status"]
+
+
+def test_python_m_catdae_version():
+    proc = subprocess.run([sys.executable, "-m", "catdae", "--version"], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0
+    assert proc.stdout.strip() == f"catdae {catdae.__version__}"
+
+
+def test_no_command_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as info:
+        main([])
+    assert info.value.code == 2
+    assert "usage" in capsys.readouterr().err
+
+
+def test_bundled_default_case_is_example_1():
+    assert default_case_path().read_text() == (CASES / "example1_free_vibration.toml").read_text()
+
+
+@pytest.mark.slow
+def test_run_without_a_case_runs_the_bundled_default(tmp_path, capsys):
+    out = tmp_path / "default.nc"
+    assert main(["run", "-o", str(out), "--no-progress"]) == 0
+    tree = catdae.read_results(out)
+    assert tree.attrs["case_name"] == "example1_free_vibration"
+    assert list(tree.children) == ["hanging", "release", "at_rest", "modes"]
+    rel = tree["release"].to_dataset()
+    assert rel.attrs["status"] == "completed"
+    assert float(rel.time[-1]) == pytest.approx(4.0)
+    # the cable is at rest under self-weight at the end: the released mass's weight of 981 N
+    # has left the reactions
+    w = 20.3 * 9.81 * 44.304
+    hang = tree["hanging"].to_dataset().reaction.sel(node=["A", "B"], axis="z").values.sum()
+    rest = tree["at_rest"].to_dataset().reaction.sel(node=["A", "B"], axis="z").values.sum()
+    assert hang == pytest.approx(w + 100.0 * 9.81, rel=1e-10)
+    assert rest == pytest.approx(w, rel=1e-10)
+    assert np.all(np.diff(tree["modes"].to_dataset().frequency.values) >= 0)
+
+
+def test_the_plain_install_brings_what_every_command_needs():
+    # `pip install -e .` (the README's install) installs the core requirements only: those
+    # without an `extra == ...` marker. catdae study needs distributed, catdae plot matplotlib,
+    # catdae export meshio.
+    from importlib.metadata import requires
+
+    from packaging.requirements import Requirement
+
+    core = {Requirement(r).name for r in requires("catdae")
+            if "extra" not in str(Requirement(r).marker or "")}
+    assert {"dask", "matplotlib", "meshio"} <= core
+    dask = next(Requirement(r) for r in requires("catdae") if Requirement(r).name == "dask"
+                and "extra" not in str(Requirement(r).marker or ""))
+    assert "distributed" in dask.extras
+
+
+def test_the_summary_names_the_free_node_that_moves_most(tmp_path, capsys):
+    # example 2's motion of support A on a taut cable: A moves most of all, and the summary
+    # must name the free node that moves most, not the prescribed support
+    text = (CASES / "example2_support_motion_gentle.toml").read_text()
+    text = (text.replace("length = 15.0", "length = 10.02").replace("0.03", "0.3")
+            .replace("duration = 4.0", "duration = 1.0"))
+    case = tmp_path / "taut.toml"
+    case.write_text(text)
+    out = tmp_path / "taut.nc"
+    assert main(["run", str(case), "--elements", "4", "--rtol", "1e-4", "-o", str(out),
+                 "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    ds = catdae.read_results(out)["excitation"].to_dataset()
+    mag = np.sqrt((ds.displacement**2).sum("axis")).max("time")
+    free = [n for n in ds.node.values if n not in ("A", "B")]
+    expected = str(mag.sel(node=free).idxmax("node").values)
+    assert float(mag.sel(node="A")) > float(mag.sel(node=expected))  # A moves most of all
+    assert f"largest motion of a free node at {expected}: " in printed

@@ -1,0 +1,283 @@
+"""Hostile case files (issue 12), through ``python -m catdae check`` and ``run``.
+
+An invalid case gets exit 2 and one clear message naming the file, the field and what was
+expected, judged before any work: no traceback, nothing written. What is accepted runs without
+NaN in its results.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+from scene_toml import cable_scene, modal_step, static_step, transient_step
+
+PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+
+
+def catdae(*args, cwd, timeout=300) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "catdae", *map(str, args)], cwd=cwd,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def massless(elements=4, extra="") -> str:
+    return cable_scene(B=(10.0, 0.0, 0.0), L0=9.5, EA=1e4, mass=0.0, weight=0.0,
+                       elements=elements, extra=PUSH + extra,
+                       steps=static_step("static") + transient_step(
+                           "dyn", 1.0, 0.1, rtol=1e-6, atol=1e-9, remove=["push"]))
+
+
+def test_a_transient_of_a_massless_cable_is_refused(tmp_path, capsys):
+    """No mass and no weight: M is zero on the free dofs; the run used to write NaN
+    accelerations and reactions."""
+    err = invalid(massless(), "steps[1]", "free node(s) c.1, c.2, c.3 have no mass", tmp_path,
+                  capsys)
+    assert "give the cable's material a mass > 0 or put a point mass there" in err
+
+
+def test_a_massless_cable_with_a_mass_on_each_free_node_is_accepted(tmp_path, capsys):
+    from catdae.cli import main
+
+    f = tmp_path / "beads.toml"
+    f.write_text(massless(elements=2, extra='[[point_masses]]\nname = "bead"\nnode = "c.1"\n'
+                                            "mass = 1.0\n"))
+    assert main(["check", str(f)]) == 0
+    assert "valid" in capsys.readouterr().out
+
+
+# ------------------------------------------------------------------------------------------------
+# the same, for each kind of hostile input; ``check`` in a new process, ``run`` in this one
+# ------------------------------------------------------------------------------------------------
+def scene(extra="", steps=None, **kw) -> str:
+    d = dict(B=(10.0, 0.0, 0.0), L0=10.5, EA=1e6, mass=1.0, elements=4)
+    d.update(kw)
+    return cable_scene(**d, extra=extra, steps=static_step("st") if steps is None else steps)
+
+
+def invalid(text: str, field: str, expected: str, tmp_path, capsys, *, subprocess_check=True,
+            name="case.toml", run_args=()) -> str:
+    """The case is refused by ``check`` and ``run`` (with ``run_args``: by ``run`` only) with
+    exit 2 and the single problem ``<file>: <field>: ...<expected>...``, without a traceback;
+    nothing is written."""
+    from catdae.cli import main
+
+    f = tmp_path / name
+    f.write_text(text)
+    want = f"catdae: invalid case: {f}: {field}: "
+    if subprocess_check:
+        proc = catdae("check", f, cwd=tmp_path, timeout=120)
+        assert proc.returncode == 2, proc.stderr
+        assert proc.stdout == "" and "Traceback" not in proc.stderr
+        assert proc.stderr.count("\n") == 1 and proc.stderr.startswith(want), proc.stderr
+        assert expected in proc.stderr, proc.stderr
+    out = tmp_path / "out.nc"
+    commands = [["run", str(f), "-o", str(out), *run_args]]
+    if not run_args:  # the file alone is invalid: check says so too
+        commands.insert(0, ["check", str(f)])
+    for args in commands:
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(want) and expected in err, err
+    assert not list(tmp_path.glob("*.nc"))
+    return err
+
+
+def valid(text: str, tmp_path, name="ok.toml"):
+    from catdae.cli import main
+
+    f = tmp_path / name
+    f.write_text(text)
+    out = tmp_path / f"{f.stem}.nc"
+    assert main(["run", str(f), "-o", str(out)]) == 0
+    import catdae
+
+    return catdae.read_results(out)
+
+
+# -- 3. table files: inside the case's folder, regular, bounded; content never echoed ----------
+def table_load(file: str) -> str:
+    return ('[[loads]]\nname = "p"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+            f'time = {{ kind = "table", file = "{file}" }}\n')
+
+
+def test_a_table_file_outside_the_case_folder_is_refused_unread(tmp_path, capsys):
+    for file in ("../../etc/passwd", "/etc/passwd"):
+        err = invalid(scene(table_load(file)), "loads[0].time.file",
+                      f"cannot read table file '{file}': it is outside the case's folder "
+                      f"({tmp_path})", tmp_path, capsys, subprocess_check=file == "/etc/passwd")
+        assert "root:" not in err
+
+
+def test_a_symbolic_link_out_of_the_case_folder_is_refused(tmp_path, capsys):
+    (tmp_path / "points.csv").symlink_to("/etc/passwd")
+    err = invalid(scene(table_load("points.csv")), "loads[0].time.file",
+                  "it is outside the case's folder", tmp_path, capsys, subprocess_check=False)
+    assert "root:" not in err
+
+
+def test_a_fifo_or_a_device_as_table_file_is_refused_without_blocking(tmp_path, capsys):
+    import os
+
+    os.mkfifo(tmp_path / "fifo.csv")
+    invalid(scene(table_load("fifo.csv")), "loads[0].time.file",
+            "cannot read table file 'fifo.csv': not a regular file", tmp_path, capsys)
+    (tmp_path / "dev").symlink_to("/dev")
+    invalid(scene(table_load("dev/zero")), "loads[0].time.file", "outside the case's folder",
+            tmp_path, capsys, subprocess_check=False)
+
+
+def test_a_device_in_an_allowed_root_is_still_refused(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("CATDAE_TABLE_ROOTS", "/dev")
+    invalid(scene(table_load("/dev/zero")), "loads[0].time.file",
+            "cannot read table file '/dev/zero': not a regular file", tmp_path, capsys,
+            subprocess_check=False)
+
+
+def test_a_table_file_above_the_size_limit_is_refused_unread(tmp_path, capsys):
+    with open(tmp_path / "huge.csv", "wb") as fh:
+        fh.truncate(16 * 2**20 + 1)  # sparse: no disk used
+    invalid(scene(table_load("huge.csv")), "loads[0].time.file",
+            "cannot read table file 'huge.csv': 16 MiB, above the limit of 16 MiB for a table "
+            "file", tmp_path, capsys, subprocess_check=False)
+
+
+def test_a_bad_table_line_is_named_not_quoted(tmp_path, capsys):
+    (tmp_path / "points.csv").write_text("t,v\n0.0,0.0\nsecret-token,hunter2\n")
+    err = invalid(scene(table_load("points.csv")), "loads[0].time.file",
+                  "'points.csv', line 3: expected two numbers 'time,value', found a field "
+                  "that is not a number", tmp_path, capsys, subprocess_check=False)
+    assert "secret" not in err and "hunter2" not in err
+
+
+def test_a_table_in_an_allowed_root_is_read(tmp_path, monkeypatch):
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    (shared / "points.csv").write_text("0.0,0.0\n1.0,2.0\n")
+    case_dir = tmp_path / "case"
+    case_dir.mkdir()
+    monkeypatch.setenv("CATDAE_TABLE_ROOTS", str(shared))
+    tree = valid(scene(table_load(str(shared / "points.csv"))), case_dir)
+    assert tree.attrs["status"] == "completed"
+
+
+def test_a_fifo_or_device_as_the_case_file_is_refused_without_blocking(tmp_path):
+    import os
+
+    fifo = tmp_path / "fifo.toml"
+    os.mkfifo(fifo)
+    for f in (fifo, Path("/dev/zero")):
+        proc = catdae("check", f, cwd=tmp_path, timeout=120)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr
+        assert proc.stderr == (f"catdae: invalid case: {f}: cannot read the case file: not a "
+                               "regular file (a case file must be an ordinary file)\n")
+
+
+# -- 4. counts: elements per cable and degrees of freedom, judged before any work ---------------
+def test_element_counts_beyond_the_limit_are_refused(tmp_path, capsys):
+    for n in (10**6, 10**9, 2**63 - 1, 10**30):
+        invalid(scene(elements=n), "cables[0].elements", "expected a value <= 10000, found the "
+                "integer", tmp_path, capsys, subprocess_check=n == 10**30)
+
+
+def test_the_elements_override_is_held_to_the_same_limits(tmp_path, capsys):
+    invalid(scene(), "elements", "expected an integer >= 1 and <= 10000, found the integer 1000000",
+            tmp_path, capsys, subprocess_check=False, run_args=["--elements", "1000000"])
+
+
+def test_a_mesh_above_the_dof_limit_is_refused(tmp_path, capsys):
+    extra = "".join(f'[[cables]]\nname = "d{k}"\nends = ["A", "B"]\nmaterial = "m"\n'
+                    f"length = {10.5 + 0.01 * k}\nelements = 10000\n" for k in range(10))
+    invalid(scene(extra, elements=10000), "cables", "the mesh would have 109991 nodes "
+            "(329973 degrees of freedom, 110000 elements), above the limit of 300000",
+            tmp_path, capsys)
+
+
+# -- 5. names: step names are netCDF group names; no control characters; mesh-node spelling ----
+def test_unsafe_step_names_are_refused(tmp_path, capsys):
+    for k, name in enumerate(["$x", ".", "a\\u0000b", "-a", "a/b", "a "]):
+        invalid(scene(steps=static_step(name)), "steps[0].name", "a step name names a group "
+                "of the results file", tmp_path, capsys, subprocess_check=k == 0)
+
+
+def test_safe_step_names_are_written_as_given(tmp_path):
+    names = ["équilibre", "ok-1", "a.b", "_x", "2nd step"]
+    tree = valid(scene(steps="".join(static_step(n) for n in names)), tmp_path)
+    assert list(tree.children) == names
+
+
+def test_control_characters_in_names_and_title_are_refused(tmp_path, capsys):
+    invalid(scene(title="a\\u0000b"), "title", "expected text without control characters, "
+            "found 'a\\x00b' (U+0000)", tmp_path, capsys, subprocess_check=False)
+    invalid(scene(cable="c\\u0007"), "cables[0].name", "(U+0007)", tmp_path, capsys,
+            subprocess_check=False)
+
+
+def test_a_mesh_node_with_a_leading_zero_is_refused(tmp_path, capsys):
+    load = '[[loads]]\nname = "p"\nnode = "c.02"\nforce = [0.0, 1.0, 0.0]\n'
+    invalid(scene(load), "loads[0].node", "mesh node 'c.02' is written with a leading zero: "
+            "its name is 'c.2'", tmp_path, capsys)
+    tree = valid(scene(load.replace("c.02", "c.2")), tmp_path)
+    assert tree.attrs["status"] == "completed"
+
+
+# -- 7. sizes: what a step stores, estimated before it starts -----------------------------------
+def test_a_transient_that_would_store_terabytes_is_refused(tmp_path, capsys):
+    steps = static_step("st") + transient_step("dyn", 1e6, 1e-6, rtol=1e-6, atol=1e-8)
+    invalid(scene(steps=steps), "steps[1].output_interval", "transient step 'dyn' would "
+            "store 1e+12 outputs of 5 nodes and 4 elements, 633 TiB, above the limit of 1 GiB "
+            "per step", tmp_path, capsys)
+
+
+def test_the_size_limit_is_judged_again_after_an_elements_override(tmp_path, capsys):
+    steps = static_step("st") + transient_step("dyn", 100.0, 1e-3, rtol=1e-6, atol=1e-8)
+    invalid(scene(steps=steps), "steps[1].output_interval", "above the limit of 1 GiB",
+            tmp_path, capsys, subprocess_check=False, run_args=["--elements", "200"])
+
+
+def test_a_modal_step_that_needs_a_dense_solve_too_large_is_refused(tmp_path, capsys):
+    invalid(scene(steps=static_step("st") + modal_step(10**9), elements=10000), "steps[1].modes",
+            "modal step 'modes': 29997 modes of 29997 free degrees of freedom need", tmp_path,
+            capsys, subprocess_check=False)
+
+
+# -- 8. no NaN on disk: degenerate time functions ------------------------------------------------
+def timed(time: str) -> str:
+    return ('[[loads]]\nname = "p"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+            f"time = {time}\n")
+
+
+DYN = static_step("st") + transient_step("dyn", 0.2, 0.05, rtol=1e-6, atol=1e-8)
+
+
+def test_a_degenerate_ramp_is_refused(tmp_path, capsys):
+    invalid(scene(timed('{ kind = "ramp", duration = 1e-200, smooth = true }'), steps=DYN),
+            "loads[0].time.duration", "expected a value >= 1e-09, found the number 1e-200",
+            tmp_path, capsys)
+
+
+def test_time_functions_that_overflow_are_refused(tmp_path, capsys):
+    for time, field, expected in [
+        ('{ kind = "sine", amplitude = 1.0, frequency = 1e300 }', "loads[0].time.frequency",
+         "expected a value <= 1000000000.0"),
+        ('{ kind = "sine", amplitude = 1e300, frequency = 1e6 }', "loads[0].time",
+         "its value, rate or second derivative overflows"),
+        ('{ kind = "ramp", duration = 1e-6, smooth = true, amplitude = 1e300 }',
+         "loads[0].time", "overflows"),
+        ('{ kind = "table", t = [0.0, 1e-300], value = [0.0, 1.0] }', "loads[0].time",
+         "overflows"),
+    ]:
+        invalid(scene(timed(time), steps=DYN), field, expected, tmp_path, capsys,
+                subprocess_check=False)
+
+
+def test_a_short_smooth_ramp_runs_without_nan(tmp_path):
+    import numpy as np
+
+    tree = valid(scene(timed('{ kind = "ramp", duration = 1e-3, smooth = true }'), steps=DYN),
+                 tmp_path)
+    ds = tree["dyn"].to_dataset()
+    assert ds.attrs["status"] == "completed"
+    for name in ("position", "velocity", "acceleration", "tension"):
+        assert np.isfinite(ds[name].values).all(), name
+    assert np.isfinite(ds.reaction.sel(node=["A", "B"]).values).all()

@@ -1,0 +1,300 @@
+"""Interrupted runs and unwritable outputs (issue 12), through the command line.
+
+The promises (README, exit codes): Ctrl-C (SIGINT) exits 130 and SIGTERM 143, with everything
+computed so far written and marked; a snapshot of a running step never says "completed"; a
+process killed outright leaves only files whose names say what they are; an output that cannot
+be written is refused before any work (exit 2), and a disk that fails during the run gives one
+line saying what was lost and where the last snapshot is (exit 1).
+
+Signals are sent to a real ``python -m catdae`` process once it shows that the transient step
+runs (its progress bar, or its first snapshot file): no fixed sleeps, generous timeouts.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import catdae
+import catdae.analysis
+import catdae.output.results
+from catdae.cli import main
+
+from repo_paths import CASES  # noqa: E402
+from scene_toml import cable_scene, static_step, transient_step
+
+THREE = CASES / "three_cables_shared_node.toml"
+PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+
+
+def long_case(path: Path, duration: float = 1000.0) -> Path:
+    """A weightless taut cable, pushed sideways, then released for ``duration`` seconds
+    (about 200 s of wall time per 1000 s simulated: always interrupted long before its end)."""
+    path.write_text(cable_scene(
+        B=(10.0, 0.0, 0.0), L0=10.0 / 1.1, EA=1e4, mass=2.0, weight=0.0, elements=2,
+        extra=PUSH, steps=static_step("static") + transient_step(
+            "dyn", duration, 0.01, rtol=1e-6, atol=1e-9, remove=["push"])))
+    return path
+
+
+def catdae_process(args, cwd, *, snapshot_seconds=None):
+    """``python -m catdae ARGS``; with ``snapshot_seconds`` the same command line with the
+    transient snapshot interval lowered (catdae.solvers.transient.INCREMENT_SECONDS, 20 s)."""
+    if snapshot_seconds is None:
+        cmd = [sys.executable, "-m", "catdae", *args]
+    else:
+        code = ("import sys, catdae.solvers.transient as t, catdae.cli as c; "
+                f"t.INCREMENT_SECONDS = {snapshot_seconds!r}; sys.exit(c.main(sys.argv[1:]))")
+        cmd = [sys.executable, "-c", code, *args]
+    return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd,
+                            env=dict(os.environ, PYTHONUNBUFFERED="1"))
+
+
+def signal_when(proc, sig, ready, timeout=180.0) -> tuple[int, str]:
+    """Send ``sig`` once ``ready(stderr so far)`` holds; return (exit code, stderr)."""
+    chunks: list[bytes] = []
+
+    def read_err():
+        while b := proc.stderr.read1(4096):
+            chunks.append(b)
+
+    reader = threading.Thread(target=read_err, daemon=True)
+    reader.start()
+    try:
+        deadline = time.monotonic() + timeout
+        while not ready(b"".join(chunks).decode(errors="replace")):
+            assert proc.poll() is None, b"".join(chunks).decode(errors="replace")
+            assert time.monotonic() < deadline, b"".join(chunks).decode(errors="replace")
+            time.sleep(0.05)
+        proc.send_signal(sig)
+        code = proc.wait(120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    reader.join(10)
+    proc.stderr.close()
+    return code, b"".join(chunks).decode(errors="replace")
+
+
+def transient_runs(err: str) -> bool:
+    """The progress bar of the transient step shows that it has passed t = 1 s."""
+    shown = re.findall(r"dyn:.*?t=([0-9.]+)/", err)
+    return bool(shown) and float(shown[-1]) > 1.0
+
+
+def test_sigterm_in_a_transient_step_keeps_and_marks_the_partial_results(tmp_path):
+    case = long_case(tmp_path / "long.toml")
+    out = tmp_path / "long.nc"
+    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], tmp_path)
+    code, err = signal_when(proc, signal.SIGTERM, transient_runs)
+    assert code == 143, err
+    assert "Traceback" not in err
+    assert "catdae: interrupted by SIGTERM" in err
+    assert f"results computed before the interrupt were written to {out}" in err
+    tree = catdae.read_results(out)
+    assert tree.attrs["status"].startswith("interrupted in step 'dyn': interrupted at t = ")
+    ds = tree["dyn"].to_dataset()
+    assert ds.attrs["status"].startswith("interrupted at t = ")
+    t_last = float(ds.time[-1])
+    assert 0.0 < t_last < 1000.0 and ds.attrs["n_outputs"] == ds.time.size
+    assert f"t = {t_last:.6g} s" in ds.attrs["status"]
+    for name in ("position", "velocity", "acceleration", "tension"):
+        assert np.isfinite(ds[name].values).all(), name
+    assert tree["static"].to_dataset().attrs["status"] == "completed"
+    # only the marked result is left: no snapshot, no temporary file
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["long.nc", "long.toml"]
+
+
+def test_a_snapshot_never_marks_the_running_step_completed(tmp_path):
+    """SIGKILL (nothing can be saved) once the first snapshot is there: the snapshot says the
+    step is running; any temporary file is named ``*.incomplete``, never ``*.nc``."""
+    case = long_case(tmp_path / "long.toml")
+    out = tmp_path / "long.nc"
+    snapshot = tmp_path / "long.partial.nc"
+    proc = catdae_process(["run", str(case), "-o", str(out), "--no-progress"], tmp_path,
+                          snapshot_seconds=0.5)
+    code, err = signal_when(proc, signal.SIGKILL, lambda _: snapshot.exists())
+    assert code == -signal.SIGKILL, err
+    tree = catdae.read_results(snapshot)
+    assert tree.attrs["status"] == "running step 'dyn' (snapshot, not a result)"
+    ds = tree["dyn"].to_dataset()
+    assert ds.attrs["status"].startswith("running (snapshot at t = ")
+    assert "completed" not in ds.attrs["status"]
+    assert tree["static"].to_dataset().attrs["status"] == "completed"
+    assert [p.name for p in tmp_path.glob("*.nc")] == ["long.partial.nc"]
+    left = {p.name for p in tmp_path.iterdir()} - {"long.toml", "long.partial.nc"}
+    assert all(n.startswith("long.partial.nc.") and n.endswith(".incomplete") for n in left), left
+
+
+def test_sigterm_while_the_results_are_written_waits_for_the_file(tmp_path, monkeypatch,
+                                                                   capsys):
+    """A signal that arrives while the complete results are being written does not cut the
+    file short: it is finished, then the run stops with 143."""
+    real = catdae.output.results.write_tree
+
+    def signalled(tree, path):
+        os.kill(os.getpid(), signal.SIGTERM)
+        return real(tree, path)
+
+    monkeypatch.setattr(catdae.output.results, "write_tree", signalled)
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 143
+    err = capsys.readouterr().err
+    assert "catdae: interrupted by SIGTERM" in err and f"written to {out}" in err
+    tree = catdae.read_results(out)
+    assert tree.attrs["status"] == "completed"
+    assert list(tree.children) == ["equilibrium", "modes"]
+    assert signal.getsignal(signal.SIGTERM) == signal.SIG_DFL  # handlers restored
+
+
+def test_sigterm_in_a_modal_step_says_where_the_results_went(tmp_path, monkeypatch, capsys):
+    def terminated(*args, **kwargs):
+        raise catdae.Interrupted(signal.SIGTERM)
+
+    monkeypatch.setattr(catdae.analysis, "solve_modal", terminated)
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 143
+    err = capsys.readouterr().err
+    assert err.splitlines() == ["catdae: interrupted by SIGTERM",
+                                f"catdae: results computed before the interrupt were written "
+                                f"to {out}"]
+    tree = catdae.read_results(out)
+    assert tree.attrs["status"] == "interrupted in step 'modes'"
+    assert list(tree.children) == ["equilibrium"]
+
+
+# ------------------------------------------------------------------------------------------------
+# outputs
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("output, why", [
+    (".", "it is a directory"),
+    ("", "it is a directory"),
+    ("/dev/null", "it exists and is not a regular file"),
+    ("{tmp}/missing/x.nc", "no directory {tmp}/missing"),
+    ("{case}", "it is the case file"),
+])
+def test_an_output_that_cannot_be_written_is_refused_before_any_work(tmp_path, monkeypatch,
+                                                                     capsys, output, why):
+    case = tmp_path / "three.toml"
+    case.write_text(THREE.read_text())
+
+    def never(*args, **kwargs):
+        raise AssertionError("a step ran")
+
+    monkeypatch.setattr(catdae.analysis, "solve_static", never)
+    monkeypatch.chdir(tmp_path)
+    output = output.format(tmp=tmp_path, case=case)
+    assert main(["run", str(case), "-o", output]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"catdae: cannot write the results to {Path(output)}: "
+                          f"{why.format(tmp=tmp_path)}")
+    assert case.read_text() == THREE.read_text()
+
+
+def test_an_unwritable_directory_is_refused_before_any_work(tmp_path, monkeypatch, capsys):
+    """As root every directory is writable, so the refusal of the system is simulated: on a
+    read-only mount os.access says no, to root too."""
+    real = os.access
+    monkeypatch.setattr(catdae.analysis.os, "access",
+                        lambda p, mode: False if Path(p) == tmp_path else real(p, mode))
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (f"catdae: cannot write the results to {out}: no "
+                                       f"permission to create files in {tmp_path}\n")
+
+
+def _fail_writes(monkeypatch, exc, *, unless=""):
+    """Every netCDF write raises ``exc``, except to a file whose name contains ``unless``."""
+    real = xr.DataTree.to_netcdf
+
+    def failing(self, path, *args, **kwargs):
+        if not unless or unless not in Path(path).name:
+            raise exc
+        return real(self, path, *args, **kwargs)
+
+    monkeypatch.setattr(xr.DataTree, "to_netcdf", failing)
+
+
+def test_a_full_disk_at_the_end_is_one_line_that_states_the_loss(tmp_path, monkeypatch,
+                                                                  capsys):
+    _fail_writes(monkeypatch, OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)))
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"catdae: {THREE}: cannot write the results to {out}: No space left on "
+                   "device; they are lost\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_netcdf_libraries_hdf_error_on_a_full_disk_is_named(tmp_path, monkeypatch, capsys):
+    """netCDF4 reports a full disk as RuntimeError('NetCDF: HDF error')."""
+    _fail_writes(monkeypatch, RuntimeError("NetCDF: HDF error"))
+    monkeypatch.setattr(catdae.output.results.shutil, "disk_usage",
+                        lambda p: SimpleNamespace(total=10**9, used=10**9 - 4096, free=4096))
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"cannot write the results to {out}: No space left on device (4096 bytes free" in err
+
+
+def test_a_full_disk_after_snapshots_points_to_the_last_snapshot(tmp_path, monkeypatch, capsys):
+    from catdae.solvers import transient
+
+    monkeypatch.setattr(transient, "INCREMENT_SECONDS", 0.0)  # a snapshot after every step
+    _fail_writes(monkeypatch, OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)),
+                 unless="partial")
+    case = long_case(tmp_path / "short.toml", duration=0.05)
+    out = tmp_path / "short.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    snapshot = tmp_path / "short.partial.nc"
+    assert err == (f"catdae: {case}: cannot write the results to {out}: No space left on "
+                   f"device; the last snapshot of the run is kept in {snapshot}\n")
+    tree = catdae.read_results(snapshot)
+    assert tree["dyn"].to_dataset().attrs["status"].startswith("running (snapshot at t = ")
+    assert not out.exists()
+
+
+def test_a_full_disk_after_a_failed_step_states_the_loss(tmp_path, monkeypatch, capsys):
+    def broken(*args, **kwargs):
+        raise catdae.ConvergenceError("no modes (test)")
+
+    monkeypatch.setattr(catdae.analysis, "solve_modal", broken)
+    _fail_writes(monkeypatch, OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)))
+    out = tmp_path / "three.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err == [f"catdae: {THREE}: no modes (test)",
+                   f"catdae: cannot write the results computed so far to {out}: No space left "
+                   "on device; they are lost"]
+
+
+def test_failed_runs_never_overwrite_an_earlier_failed_file(tmp_path, monkeypatch, capsys):
+    def broken(*args, **kwargs):
+        raise catdae.ConvergenceError("no modes (test)")
+
+    monkeypatch.setattr(catdae.analysis, "solve_modal", broken)
+    out = tmp_path / "three.nc"
+    out.write_bytes(b"earlier")
+    (tmp_path / "three.failed.nc").write_bytes(b"earlier failure")
+    assert main(["run", str(THREE), "-o", str(out)]) == 1
+    assert f"written to {tmp_path / 'three.failed-2.nc'}" in capsys.readouterr().err
+    assert out.read_bytes() == b"earlier"
+    assert (tmp_path / "three.failed.nc").read_bytes() == b"earlier failure"
+    tree = catdae.read_results(tmp_path / "three.failed-2.nc")
+    assert tree.attrs["status"].startswith("failed in step 'modes'")

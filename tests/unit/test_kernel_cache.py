@@ -1,0 +1,70 @@
+"""numba stamps a cached kernel with its own file only (catdae/element/cache.py): the cached
+kernels of all kernel modules are dropped together when any of their sources changes, so an
+edit of catenary.py cannot leave element_mass.py's cached kernels running the old code."""
+
+from __future__ import annotations
+
+from catdae.element.cache import KERNEL_MODULES, purge_stale
+
+
+def _tree(tmp_path):
+    for name in KERNEL_MODULES:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / f"{name}.py").write_text(f"# {name}\n")
+    cache = tmp_path / "element" / "__pycache__"
+    cache.mkdir(exist_ok=True)
+    return cache
+
+
+def _leaf(m):
+    return m.rsplit("/", 1)[-1]
+
+
+def _fill(cache):
+    names = [f"{_leaf(m)}._k-1.py311.{ext}" for m in KERNEL_MODULES for ext in ("nbi", "nbc")]
+    names += ["catenary.cpython-311.pyc", "other._k-1.py311.nbi"]
+    for n in names:
+        (cache / n).write_text("x")
+    return names
+
+
+def test_cached_kernels_go_together_when_one_kernel_source_changes(tmp_path):
+    cache = _tree(tmp_path)
+    _fill(cache)
+    assert purge_stale(tmp_path)  # no digest yet: whatever is cached may be stale
+    left = sorted(p.name for p in cache.iterdir())
+    assert left == ["catenary.cpython-311.pyc", "other._k-1.py311.nbi"]
+    assert (tmp_path / "__pycache__" / "catdae-kernels.sha256").is_file()
+
+    _fill(cache)
+    assert not purge_stale(tmp_path)  # sources unchanged: the cache stays
+    assert all((cache / n).exists() for n in _fill(cache))
+
+    (tmp_path / "element" / "catenary.py").write_text("# catenary, edited\n")
+    assert purge_stale(tmp_path)
+    for m in KERNEL_MODULES:  # the callers' kernels too, not only catenary's
+        assert not list(cache.glob(f"{_leaf(m)}.*.nb?")), m
+    assert (cache / "other._k-1.py311.nbi").exists()
+    assert not purge_stale(tmp_path)
+
+
+def test_a_missing_or_read_only_cache_folder_is_no_error(tmp_path):
+    for name in KERNEL_MODULES:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / f"{name}.py").write_text("")
+    assert not purge_stale(tmp_path)  # creates the folder and the digest, deletes nothing
+    assert (tmp_path / "__pycache__" / "catdae-kernels.sha256").is_file()
+    assert not purge_stale(tmp_path / "missing")  # sources missing: no error, nothing done
+
+
+def test_every_module_with_compiled_kernels_is_in_the_digest():
+    """A module with numba kernels left out of KERNEL_MODULES would bring the stale-cache
+    problem back for its callers."""
+    from pathlib import Path
+
+    import catdae
+
+    root = Path(catdae.__file__).parent
+    with_kernels = {p.relative_to(root).with_suffix("").as_posix() for p in root.rglob("*.py")
+                    if "@njit" in p.read_text()}
+    assert with_kernels == set(KERNEL_MODULES)

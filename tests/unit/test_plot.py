@@ -1,0 +1,143 @@
+"""Figures (``catdae.plot``, ``catdae plot``) are drawn from the right data: the plotted lines
+hold the dataset's values at the right nodes, times and cables, in order along each cable; axes
+carry the variables' units; the spectrum peaks at the frequency the modal step finds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import catdae
+from catdae.cli import main
+from catdae.output import plot
+
+from repo_paths import CASES  # noqa: E402
+
+EX1 = CASES / "example1_free_vibration.toml"
+THREE = CASES / "three_cables_shared_node.toml"
+NE = 8
+MAIN = ["A", *[f"main.{k}" for k in range(1, NE)], "B"]  # cable main from its first end
+
+
+@pytest.fixture(scope="module")
+def ex1(tmp_path_factory):
+    out = tmp_path_factory.mktemp("plot") / "ex1.nc"
+    catdae.run(EX1, elements=NE, rtol=1e-6, output=out, progress=False)
+    return catdae.read_results(out), out
+
+
+def _lines(ax, gid_prefix):
+    return [ln for ln in ax.get_lines() if str(ln.get_gid()).startswith(gid_prefix)]
+
+
+def test_profile_draws_each_cable_through_its_nodes_in_order(ex1):
+    tree, _ = ex1
+    ds = tree["release"].to_dataset()
+    fig = plot.profile(ds, times=[0.0, 1.0])
+    ax_e, ax_p = fig.axes
+    for t in (0.0, 1.0):
+        x = ds.position.sel(time=t, node=MAIN)
+        (le,) = _lines(ax_e, f"main|{t}")
+        (lp,) = _lines(ax_p, f"main|{t}")
+        np.testing.assert_array_equal(le.get_xdata(), x.sel(axis="x").values)
+        np.testing.assert_array_equal(le.get_ydata(), x.sel(axis="z").values)
+        np.testing.assert_array_equal(lp.get_ydata(), x.sel(axis="y").values)
+    # along the cable: x grows from support A to support B
+    assert np.all(np.diff(_lines(ax_e, "main|0.0")[0].get_xdata()) > 0)
+    assert ax_e.get_ylabel().endswith("z [m]") and ax_p.get_xlabel().endswith("x [m]")
+
+
+def test_profile_of_a_network_draws_the_shared_node_on_every_cable():
+    tree = catdae.run(THREE, progress=False)
+    ds = tree["equilibrium"].to_dataset()
+    fig = plot.profile(ds)
+    case = catdae.load_case(THREE)
+    for cable in case.cables:
+        (ln,) = _lines(fig.axes[0], f"{cable.name}|")
+        a, b = (ds.position.sel(node=n) for n in cable.ends)
+        assert len(ln.get_xdata()) == cable.elements + 1
+        assert (ln.get_xdata()[0], ln.get_ydata()[0]) == (a.sel(axis="x"), a.sel(axis="z"))
+        assert (ln.get_xdata()[-1], ln.get_ydata()[-1]) == (b.sel(axis="x"), b.sel(axis="z"))
+
+
+def test_history_is_the_displacement_of_the_node(ex1):
+    tree, _ = ex1
+    ds = tree["release"].to_dataset()
+    fig = plot.history(ds, "main.4")
+    for ax, a in zip(fig.axes, "xyz", strict=True):
+        (ln,) = ax.get_lines()
+        np.testing.assert_array_equal(ln.get_xdata(), ds.time.values)
+        np.testing.assert_array_equal(ln.get_ydata(), ds.displacement.sel(node="main.4",
+                                                                          axis=a).values)
+        assert ax.get_ylabel() == f"{a} [m]"
+    assert fig.axes[-1].get_xlabel() == "time [s]"
+    # default node: the free node that moves most (midspan, where the mass was released)
+    assert str(plot.history(ds).axes[0].get_lines()[0].get_gid()).startswith("main.4|")
+
+
+def test_the_spectrum_peaks_at_the_first_symmetric_in_plane_mode(ex1):
+    tree, _ = ex1
+    ds = tree["release"].to_dataset()
+    md = tree["modes"].to_dataset()
+    fig = plot.spectrum(ds, "main.4")
+    (ln,) = _lines(fig.axes[0], "main.4|z")
+    f, amp = ln.get_xdata(), ln.get_ydata()
+    sym_in = md.frequency.where((md.plane == "in-plane") & (md.symmetry == "symmetric"),
+                                drop=True)
+    f1 = float(sym_in[0])
+    resolution = 1.0 / float(ds.time[-1] - ds.time[0])
+    assert abs(f[np.argmax(amp)] - f1) <= resolution, (f[np.argmax(amp)], f1)
+    assert fig.axes[0].get_xlabel() == "frequency [Hz]"
+
+
+def test_amplitude_spectrum_of_a_sine():
+    t = np.arange(0, 20.0, 0.01)
+    f, amp = plot.amplitude_spectrum(t, 0.3 * np.sin(2 * np.pi * 2.0 * t) + 5.0)
+    k = np.argmax(amp)
+    assert f[k] == pytest.approx(2.0) and amp[k] == pytest.approx(0.3, rel=1e-2)
+
+
+def test_tension_along_the_cable_and_at_the_supports(ex1):
+    tree, _ = ex1
+    ds = tree["release"].to_dataset()
+    fig = plot.tension(ds, times=[2.0])
+    ax_s, ax_t = fig.axes
+    (ln,) = _lines(ax_s, "main|2.0")
+    el = [f"main.{k}" for k in range(1, NE + 1)]
+    np.testing.assert_array_equal(ln.get_ydata(), ds.tension.sel(time=2.0, element=el)
+                                  .values.ravel())
+    s = ln.get_xdata()
+    assert s[0] == 0.0 and s[-1] == pytest.approx(44.304) and np.all(np.diff(s) >= 0)
+    (la,) = _lines(ax_t, "A")
+    ra = ds.reaction.sel(node="A")
+    np.testing.assert_allclose(la.get_ydata(), np.sqrt((ra**2).sum("axis")).values)
+    assert ax_s.get_ylabel().endswith("[N]") and ax_s.get_xlabel().endswith("[m]")
+    # the force on the cable at the support is the tension of its end element, less the
+    # inertia of the mass the support carries (here below 1e-3 of it)
+    np.testing.assert_allclose(la.get_ydata(), ds.tension.sel(element="main.1", end="i"),
+                               rtol=1e-3)
+
+
+def test_modes_are_the_shapes_along_the_cable_with_their_frequencies(ex1):
+    tree, _ = ex1
+    md = tree["modes"].to_dataset()
+    fig = plot.modes(md, n=4)
+    for k, ax in enumerate(fig.axes):
+        mode = k + 1
+        (lz,) = _lines(ax, f"{mode}|main|z")
+        np.testing.assert_array_equal(lz.get_ydata(), md["shape"].sel(mode=mode, node=MAIN,
+                                                                      axis="z").values)
+        x = lz.get_xdata()
+        assert x[0] == 0.0 and x[-1] == pytest.approx(44.304)  # arc length from A to B
+        assert f"{float(md.frequency.sel(mode=mode)):.4g} Hz" in ax.get_title()
+
+
+def test_catdae_plot_writes_png_files(ex1, tmp_path, capsys):
+    _, out = ex1
+    assert main(["plot", str(out), "-o", str(tmp_path / "figs"), "--step", "release",
+                 "--what", "history", "spectrum", "--node", "main.2"]) == 0
+    files = sorted(p.name for p in (tmp_path / "figs").iterdir())
+    assert files == ["release-history.png", "release-spectrum.png"]
+    assert (tmp_path / "figs" / "release-history.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["plot", str(out), "-o", str(tmp_path / "x"), "--node", "nowhere"]) == 2
+    assert "no node 'nowhere'" in capsys.readouterr().err

@@ -1,0 +1,270 @@
+"""Work-precision studies: errors shrink as tolerances tighten and meshes refine, the modal
+convergence order is the one theory predicts, a real Dask cluster gives the local numbers, and
+a stored study is not recomputed."""
+
+from __future__ import annotations
+
+import math
+import socket
+
+import distributed
+import numpy as np
+import pytest
+import xarray as xr
+
+import catdae
+from catdae import study
+from catdae.case import load_case
+from catdae.study import StudyError, convergence_order, run_study
+
+from repo_paths import CASES  # noqa: E402
+from scene_toml import cable_scene, modal_step, static_step
+
+GENTLE = CASES / "example2_support_motion_gentle.toml"
+EXAMPLE1 = CASES / "example1_free_vibration.toml"
+
+# Example 1's taut cable (span 44.335 m, unstrained length 44.304 m), statics then modes.
+TAUT = cable_scene(B=(44.335, 0.0, 0.0), L0=44.304, EA="4.696e8", mass=20.3, elements=8,
+                   title="taut cable, modes", material="strand", cable="main",
+                   steps=static_step("hanging") + modal_step(4))
+
+COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
+
+
+def _values(ds: xr.Dataset, name: str) -> np.ndarray:
+    return np.asarray(ds[name].values, float).ravel()
+
+
+def test_error_shrinks_as_the_tolerance_tightens():
+    # Example 2, gentle scene, 0.3 s on 4 elements. atol is held far below rtol x motion so
+    # that rtol controls the error; the reference (same mesh, rtol/100) then measures the time
+    # integration error alone. Measured: 2.3e-5, 4.5e-7, 1.5e-8 m.
+    ds = run_study(GENTLE, rtol=[1e-3, 1e-5, 1e-7], atol=[1e-10], elements=[4], duration=0.3,
+                   scheduler="synchronous")
+    assert ds.attrs["reference_rtol"] == pytest.approx(1e-9)
+    assert ds.attrs["reference_elements"] == 4
+    assert (ds.status.values == "completed").all()
+    err = _values(ds, "error")
+    assert err[0] > 10 * err[1] > 100 * err[2] > 0
+    assert (np.diff(_values(ds, "n_residual_evaluations")) > 0).all()  # tighter costs more
+    assert (_values(ds, "peak_memory") >= 0).all()
+    assert ds.attrs["peak_memory_method"] in ("peak_rss", "maxrss")
+    for v in ("wall_time", *COUNTS, "peak_memory", "error", "status"):
+        assert ds[v].dims == study.SETTINGS
+        assert "long_name" in ds[v].attrs
+    for v in ("wall_time", *COUNTS, "peak_memory", "error"):
+        assert ds[v].attrs["units"]
+    for v in ("status", "mass_model", "linear_solver"):  # labels: no units
+        assert "units" not in ds[v].attrs and ds[v].attrs["long_name"]
+
+
+def test_error_shrinks_as_the_mesh_refines():
+    # Example 1: the released taut cable, 0.25 s. The hung mass sits at midspan, a node of
+    # every even mesh, and the reference has 2 x 16 elements. Measured 6.7e-3, 1.9e-3, 6.3e-4 m
+    # (order 1.7: the released mass sends kinks along the cable, which converge slowly).
+    ds = run_study(EXAMPLE1, elements=[4, 8, 16], rtol=[1e-5], atol=[1e-9], duration=0.25,
+                   scheduler="synchronous")
+    assert ds.attrs["reference_elements"] == 32
+    assert ds.attrs["response"] == "main@1/2"  # the midspan node moves most
+    err = ds.error.squeeze()
+    assert (err.diff("elements") < 0).all(), err.values
+    assert convergence_order(err) > 0.5
+
+
+@pytest.mark.parametrize("mass_model, sign", [("consistent", 1.0), ("lumped", -1.0)])
+def test_modal_frequencies_converge_at_the_order_theory_predicts(tmp_path, mass_model, sign):
+    # Two-node elements with linear-like interpolation on a taut cable: the discrete string
+    # frequencies are omega_h = omega (1 + (k h)^2 / 24 + ...) with the consistent mass and
+    # omega (1 - (k h)^2 / 24 + ...) with the lumped mass, k h = pi j / n for mode j (the
+    # standard dispersion of linear finite elements, e.g. Hughes, The Finite Element Method,
+    # 9.x): second order, from above and from below. The band 1.7-2.3 allows for the
+    # pre-asymptotic higher terms; the reference is a 256-element mesh, so its own error is
+    # (8/256)^2 = 0.1 % of the coarsest run's and does not bias the slope.
+    case = load_case(TAUT)
+    ds = run_study(case, elements=[8, 16, 32], mass_model=[mass_model],
+                   reference={"elements": 256}, scheduler="synchronous")
+    ferr = ds.frequency_error.squeeze()  # (elements, mode)
+    for mode in ferr.mode.values:
+        p = convergence_order(abs(ferr.sel(mode=mode)))
+        assert 1.7 < p < 2.3, (mode, p)
+    assert (np.sign(ferr.values) == sign).all()
+    # mode 1 is the first out-of-plane (string) mode: (f_h - f) / f = (pi / n)^2 / 24
+    e1 = ferr.sel(mode=1).values * ferr.elements.values**2
+    assert np.allclose(sign * e1, math.pi**2 / 24, rtol=0.03), e1
+    fig = study.plot_convergence(ds, tmp_path / "conv.png")
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert legend == [f"order {convergence_order(ds.error.squeeze()):.2f}"]
+    assert (tmp_path / "conv.png").stat().st_size > 1000
+
+
+@pytest.fixture
+def port_8787_taken():
+    """Port 8787 (Dask's default dashboard port) held by someone else, as a Jupyter or another
+    Dask dashboard would; pytest's warnings-as-errors turns distributed's "Port 8787 is already
+    in use" warning into a failure, so a cluster that reaches for 8787 fails the test."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    try:
+        sock.bind(("127.0.0.1", 8787))
+    except OSError:  # already taken by another process: the same situation
+        sock.close()
+        yield None
+        return
+    sock.listen(1)
+    yield sock
+    sock.close()
+
+
+def test_a_dask_cluster_gives_the_local_numbers(port_8787_taken):
+    kw = dict(rtol=[1e-3, 1e-5], atol=[1e-10], elements=[4], duration=0.2)
+    local = run_study(GENTLE, scheduler="synchronous", **kw)
+    with study.local_cluster(1) as cluster:
+        assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")
+        assert cluster.scheduler.http_server.port != 8787
+        remote = run_study(GENTLE, scheduler=cluster.scheduler_address, **kw)
+    assert remote.attrs["scheduler"] == cluster.scheduler_address
+    assert (remote.status.values == "completed").all()
+    for v in COUNTS:
+        np.testing.assert_array_equal(remote[v].values, local[v].values)
+    np.testing.assert_allclose(remote.error.values, local.error.values, rtol=1e-9)
+
+
+def test_the_default_cluster_runs_while_port_8787_is_taken(port_8787_taken, tmp_path):
+    # the study's own LocalCluster (scheduler=None), as `catdae study` starts it
+    ds = run_study(GENTLE, rtol=[1e-3], atol=[1e-10], elements=[4], duration=0.1, workers=1,
+                   store=tmp_path / "store")
+    assert ds.attrs["scheduler"].startswith("distributed.LocalCluster")
+    assert (ds.status.values == "completed").all()
+
+
+def test_a_stored_study_is_not_recomputed(tmp_path, monkeypatch):
+    kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4], duration=0.2,
+              scheduler="synchronous", store=tmp_path / "store")
+    first = run_study(GENTLE, **kw)
+    assert first.attrs["n_runs_computed"] == 2
+    assert len(list((tmp_path / "store").glob("*.nc"))) == 3  # two runs and the reference
+    calls = []
+    real = study.execute
+
+    def counting(*args, **kwargs):
+        calls.append(args)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(study, "execute", counting)
+    again = run_study(GENTLE, **kw)
+    assert calls == []
+    assert again.attrs["n_runs_computed"] == 0
+    for v in ("error", *COUNTS, "wall_time", "status"):
+        np.testing.assert_array_equal(again[v].values, first[v].values)
+    # a lost run (its file gone) is the only one computed again
+    runs = sorted((tmp_path / "store").glob("*.nc"))
+    victim = next(p for p in runs if xr.load_dataset(p).attrs["settings"].count("0.0001"))
+    victim.unlink()
+    third = run_study(GENTLE, **kw)
+    assert len(calls) == 1 and third.attrs["n_runs_computed"] == 1
+    np.testing.assert_array_equal(third.error.values, first.error.values)
+
+
+def test_a_run_lost_on_the_cluster_is_recomputed_on_rerun(tmp_path, monkeypatch):
+    # A worker thread in this process (processes=False) sees the monkeypatched task: the
+    # rtol=1e-4 run fails as a lost worker or a bug would, outside catdae's own errors.
+    real = study.execute
+
+    def flaky(case_run, step_name, memory="rss"):
+        if case_run.steps[-1].rtol == 1e-4:
+            raise RuntimeError("worker lost")
+        return real(case_run, step_name, memory)
+
+    kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4], duration=0.1,
+              store=tmp_path / "store")
+    monkeypatch.setattr(study, "execute", flaky)
+    with study.local_cluster(1, processes=False) as cluster, \
+            distributed.Client(cluster) as client:
+        first = run_study(GENTLE, scheduler=client, **kw)
+        status = first.status.squeeze()
+        assert status.sel(rtol=1e-3) == "completed"
+        assert status.sel(rtol=1e-4) == "error: RuntimeError: worker lost"
+        assert np.isnan(first.error.squeeze().sel(rtol=1e-4))
+        monkeypatch.setattr(study, "execute", real)
+        again = run_study(GENTLE, scheduler=client, **kw)
+    assert again.attrs["n_runs_computed"] == 1
+    assert (again.status.values == "completed").all()
+
+
+def test_a_crashed_study_resumes(tmp_path, monkeypatch):
+    kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4], duration=0.2,
+              scheduler="synchronous", store=tmp_path / "store")
+
+    def crash(settings, run):
+        if settings is not None:  # after the reference and the first run are stored
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_study(GENTLE, on_run=crash, **kw)
+    assert len(list((tmp_path / "store").glob("*.nc"))) == 2
+    resumed = run_study(GENTLE, **kw)
+    assert resumed.attrs["n_runs_computed"] == 1
+    assert (resumed.status.values == "completed").all()
+
+
+def test_a_given_reference_gives_the_automatic_errors():
+    # the automatic reference, computed outside the study with catdae.run, passed as a tree
+    kw = dict(rtol=[1e-3, 1e-4], atol=[1e-10], elements=[4, 8], duration=0.1,
+              scheduler="synchronous")
+    auto = run_study(GENTLE, **kw)
+    ref_settings = {k: auto.attrs[f"reference_{k}"] for k in study.SETTINGS}
+    ref_case = study.configure(load_case(GENTLE), "excitation", ref_settings, duration=0.1)
+    given = run_study(GENTLE, reference=catdae.run(ref_case), **kw)
+    assert given.attrs["reference"] == "given by the user"
+    assert given.attrs["response"] == auto.attrs["response"]
+    np.testing.assert_allclose(given.error.values, auto.error.values, rtol=1e-12)
+
+
+def test_grids_without_a_common_node_are_rejected():
+    # example 2's named nodes are both pinned supports: only mesh nodes can be compared, and
+    # meshes of 5 and 8 elements share none.
+    with pytest.raises(StudyError, match="no node is common to every mesh"):
+        run_study(GENTLE, elements=[5, 8], scheduler="synchronous")
+    # cable.3 of the case file's 10 elements is at 3/10 of the cable: not a node of 8 elements
+    with pytest.raises(StudyError, match=r"cable@3/10.*not a node of every mesh"):
+        run_study(GENTLE, elements=[8], response="cable.3", scheduler="synchronous")
+    with pytest.raises(StudyError, match="rtol: not a setting of the modal step"):
+        run_study(TAUT, rtol=[1e-3])
+    with pytest.raises(StudyError, match="max_order: expected an integer from 1 to 5"):
+        run_study(GENTLE, max_order=[7])
+    with pytest.raises(StudyError, match="memory: expected 'rss' or 'tracemalloc'"):
+        run_study(GENTLE, memory="psutil", scheduler="synchronous")
+
+
+def test_response_names(tmp_path):
+    # cable.5 of the case file's 10 elements is the midspan node, cable@1/2, cable.2 of 4
+    ds = run_study(GENTLE, elements=[4], rtol=[1e-4], atol=[1e-9], duration=0.1,
+                   response="cable.5", scheduler="synchronous")
+    assert ds.attrs["response"] == "cable@1/2"
+    assert np.isfinite(ds.error).all()
+
+
+def test_command_line(tmp_path, capsys):
+    out = tmp_path / "s.nc"
+    code = study.main([str(GENTLE), "--rtol", "1e-3", "1e-5", "--atol", "1e-10", "--elements",
+                       "4", "--duration", "0.2", "--scheduler", "synchronous", "--store",
+                       str(tmp_path / "store"), "-o", str(out)])
+    assert code == 0, capsys.readouterr().err
+    ds = xr.load_dataset(out)
+    assert ds.error.attrs["units"] == "m" and ds.sizes["rtol"] == 2
+    assert (tmp_path / "s-work-precision.png").stat().st_size > 1000
+    assert not (tmp_path / "s-convergence.png").exists()  # one element count: no order
+    assert "rtol=0.001: completed" in capsys.readouterr().out
+    taut = tmp_path / "taut.toml"
+    taut.write_text(TAUT)
+    modal = tmp_path / "m.nc"
+    code = study.main([str(taut), "--elements", "4", "8", "--reference", "elements=32",
+                       "--scheduler", "synchronous", "--store", str(tmp_path / "mstore"), "-o",
+                       str(modal)])
+    assert code == 0, capsys.readouterr().err
+    ds = xr.load_dataset(modal)
+    assert ds.attrs["reference_elements"] == 32 and ds.sizes["mode"] == 4
+    assert (tmp_path / "m-convergence.png").exists()
+    bad = study.main([str(GENTLE), "--elements", "5", "8", "--scheduler", "synchronous",
+                      "--store", str(tmp_path / "store"), "-o", str(out)])
+    assert bad == 2
+    assert "no node is common" in capsys.readouterr().err
