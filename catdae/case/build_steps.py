@@ -11,6 +11,7 @@ from typing import Any
 from catdae.case.messages import _fmt_path, _found, _is_number, _short, _unknown
 from catdae.case.model import (
     AXES,
+    AxialDamping,
     Damping,
     FrozenMap,
     Step,
@@ -19,6 +20,7 @@ from catdae.case.model import (
 from catdae.case.schema import (
     _DAMPING_MODELS,
     _STEP_MODELS,
+    _AxialDamping,
     _SupportMotion,
 )
 
@@ -124,7 +126,8 @@ class _StepsPass:
                 extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
-                         "mass_model": v.mass_model, "inertia": v.inertia}
+                         "mass_model": v.mass_model, "inertia": v.inertia,
+                         "axial_damping": self.axial_damping(v.axial_damping, where)}
             temperature = self.temperature(v.temperature_change, where)
             if complete and temperature is not False:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
@@ -192,6 +195,21 @@ class _StepsPass:
                 else:
                     presence[r] = (key == "add", f"added by {here}" if key == "add"
                                    else f"already removed by {here}")
+
+    def axial_damping(self, raw: dict | None, step_where: tuple) -> AxialDamping | None:
+        if raw is None:
+            return None
+        where = step_where + ("axial_damping",)
+        if not isinstance(raw, dict):
+            self.problem(where, "expected a table { ratio = .., frequency = .. } (ratio: share "
+                         "of critical, frequency: Hz or \"element\"), found "
+                         f"{_found(raw)}")
+            return None
+        v, complete = self.validate(_AxialDamping, raw, where)
+        if v is None or not complete:
+            return None
+        f = v.frequency if v.frequency == "element" else float(v.frequency)
+        return AxialDamping(ratio=float(v.ratio), frequency=f)
 
     def damping(self, raw: dict, step_where: tuple) -> Damping | None:
         where = step_where + ("damping",)

@@ -202,6 +202,16 @@ class Damping:
 
 
 @dataclass(frozen=True)
+class AxialDamping:
+    """Strain-rate (Kelvin-Voigt) damping of a transient step: a share ``ratio`` of critical at
+    ``frequency`` (Hz), or at each element's highest axial frequency (``"element"``); it acts
+    on the axial strain rate only (docs/theory.md §12)."""
+
+    ratio: float
+    frequency: float | Literal["element"] = "element"
+
+
+@dataclass(frozen=True)
 class Step:
     """One analysis step. Fields that do not apply to ``kind`` keep their defaults.
 
@@ -214,7 +224,8 @@ class Step:
     ``rtol``, ``atol``, ``damping``, ``max_order`` (IDA's BDF order limit), ``linear_solver``,
     ``mass_model``, ``inertia`` ("lagrangian": M(q) v' plus the velocity terms of Lagrange's
     equations for T = ½ vᵀ M(q) v, which conserve energy; "paper": M(q) v' alone, the form of
-    Chang, Park & Lee 2008, which does not).
+    Chang, Park & Lee 2008, which does not), ``axial_damping`` (strain-rate damping, None:
+    none).
     """
 
     kind: Literal["static", "modal", "transient"]
@@ -233,6 +244,7 @@ class Step:
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
+    axial_damping: AxialDamping | None = None
 
     def __post_init__(self):
         if isinstance(self.temperature_change, Mapping):

@@ -137,6 +137,7 @@ class _TransientStep(BaseModel):
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
+    axial_damping: TomlTable | None = None
 
 
 class _Form(BaseModel):
@@ -169,6 +170,14 @@ class _RayleighDamping(BaseModel):
     beta: NonNeg | None = None
     ratio: Pos | None = None
     frequencies: Annotated[list[Pos], Field(min_length=2, max_length=2)] | None = None
+
+
+class _AxialDamping(BaseModel):
+    """``axial_damping = { ratio = .., frequency = .. }`` of a transient step."""
+
+    model_config = _STRICT
+    ratio: Pos
+    frequency: Pos | Literal["element"] = "element"
 
 
 _DAMPING_MODELS: dict[str, type[BaseModel]] = {

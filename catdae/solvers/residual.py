@@ -49,6 +49,7 @@ from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.output.transient import potential
+from catdae.solvers.axial_damping import AxialDamping
 
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
 
@@ -132,6 +133,10 @@ class TransientProblem:
         self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
         self._fast_setup()
+        # strain-rate damping (docs/theory.md §12): None unless the step asks for it
+        self.axial = AxialDamping.of(model, step)
+        self._unknown = np.full(nd, -1, np.int64)
+        self._unknown[self.fidx] = np.arange(self.n)
 
     def _fast_setup(self) -> None:
         """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
@@ -196,6 +201,9 @@ class TransientProblem:
         if not ok:
             self._buffers_at = None
             return False
+        if self.axial is not None:
+            self.axial.rates(self._Xb, self._Vb, self._hw, self._kmat)
+            self.axial.add_residual(self._unknown, res)
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = (t, np.array(y[0::2], copy=True))
@@ -273,6 +281,9 @@ class TransientProblem:
         out += self.m_diag * A - m.nodal_load(t)
         if damped:
             out += (self.c_diag + self.alpha * self.m_diag) * V
+        if self.axial is not None:
+            self.axial.rates(self.X, V, state.h, state.K)
+            self.axial.add_forces(out)
         return out
 
     def blocks(self, conf, cj, V=None, A=None):
@@ -333,6 +344,14 @@ class TransientProblem:
         if conf[3] is not None:
             V, A = self.full_vectors(t, y[1::2], yp[1::2])
         kdata, vdata = self.blocks(conf, cj, V, A)
+        if self.axial is not None:
+            if V is None:
+                V, _ = self.full_vectors(t, y[1::2], yp[1::2])
+            X = np.empty(self.n_dof)
+            X[self.fidx] = y[0::2]
+            X[self.model.fixed] = self._supports(t)[0]
+            self.axial.rates(X, V, conf[0].h, conf[0].K)
+            vdata = vdata + self.model.pattern.assemble(self.axial.velocity_blocks())
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
@@ -409,6 +428,9 @@ class TransientProblem:
         if np.any(dvs) and m.mass_model != "lumped":
             full = m.pattern.matrix(mdata)
             v0 -= spla.spsolve(mff, full[self.fidx][:, m.fixed] @ dvs)
+        if self.axial is not None:  # the chords of q0 for the strain rates
+            self.X[self.fidx] = q0
+            self.X[m.fixed] = self._supports(t0)[0]
         V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
         f = self.dynamic_force(t0, conf, V_full, A_full)  # M_fp a_p + C v + F - P
         a0 = spla.spsolve(mff, -f[self.fidx])
@@ -431,6 +453,10 @@ class TransientProblem:
         X, V, A = self._Xb.copy(), self._Vb.copy(), self._Ab.copy()
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         f = self._force + self.m_diag * A + self._v_diag * V - p  # M A + C V + g + F - P
+        tension = m.elements.end_tensions(h)
+        if self.axial is not None:  # evaluate left the rates of this state
+            self.axial.add_forces(f)
+            tension = tension + self.axial.tension()[:, None]
         reaction = np.full(self.n_dof, np.nan)
         reaction[m.fixed] = f[m.fixed]
         kinetic = 0.5 * float(self.m_diag @ (V * V))
@@ -438,6 +464,6 @@ class TransientProblem:
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
-        return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
+        return (X, V, A, tension, reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
 

@@ -26,6 +26,7 @@ from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.output.transient import Outputs, note
 from catdae.progress import reporter
+from catdae.solvers.envelope import TensionEnvelope
 from catdae.solvers.residual import TransientProblem
 
 __all__ = ["IDA", "OrderChoice", "TransientProblem", "choose_solver", "run_transient"]
@@ -93,7 +94,11 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     solver.init_step(t0, y0, yp0)
 
     outputs = Outputs(prob, times)
-    record = outputs.record
+    envelope = TensionEnvelope(prob)  # over every accepted step, not only the outputs
+
+    def record(k, t, y, yp):
+        outputs.record(k, t, y, yp)
+        envelope.update(t, tension=outputs.T[k])
 
     n_steps = 0
     n_restarts = 0
@@ -121,8 +126,10 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
             "n_outputs": n_valid, "n_restarts": n_restarts, "note": note(model, prob),
+            "axial_damping": "none" if prob.axial is None else prob.axial.describe(),
         }
-        return outputs.dataset(n_valid, attrs)
+        ds = outputs.dataset(n_valid, attrs)
+        return ds.assign(envelope.variables())
 
     try:
         record(0, t0, y0, yp0)
@@ -148,6 +155,7 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             t_new = float(np.atleast_1d(res.t)[-1])
             if t_new > t_int:
                 n_steps += 1
+                envelope.update(t_new, np.atleast_2d(res.y)[-1])
             # IDA's max_num_steps counts per call; in one-step mode guard the step size
             # ourselves: steps that no longer advance time mean the integration is stuck
             stalled = stalled + 1 if t_new - t_int <= STALL_STEP * max(abs(t_new), dt_out) else 0

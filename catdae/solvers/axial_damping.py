@@ -1,0 +1,151 @@
+"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §12).
+
+A Kelvin-Voigt material carries, besides its elastic tension, a viscous tension η A ε̇ on the
+rate of axial strain only. An element's strain is that of its catenary: the elastic elongation
+e = ∫₀^L0 T(s)/EA ds, a function of the chord c = x_j - x_i through the end force h(c). With a
+uniform viscous tension c_d ė (c_d = η A / L0, ė the elongation rate) the Rayleigh dissipation
+function is D = ½ c_d ė²; with ė = g·ċ and g = ∂e/∂c the element forces are
+
+    f_i = -c_d ė g,   f_j = +c_d ė g        (added to the resisting forces)
+
+g comes from the element solve without a new integral: T = |t(s)| with ∂t(s)/∂h = I, so
+∂e/∂h = (1/EA) ∫ t̂ ds, and the chord is c = ∫ t̂ ds + (1/EA) ∫ t ds (t linear in s between the
+concentrated loads), hence
+
+    ∂e/∂h = (c - (1/EA) ∫ t ds) / EA,    g = K ∂e/∂h   (K = ∂h/∂c, symmetric)
+
+A straight taut element has g = ĉ (the unit chord); a rigid rotation has ė = 0 (the swing of a
+taut line is not damped); a slack element (K = 0) has g = 0. The iteration matrix gets
+∂f/∂v = c_d [[g gᵀ, -g gᵀ], [-g gᵀ, g gᵀ]]; the derivative of g with respect to the positions
+is left out (it is of the order of c_d ė / ℓ, small beside the geometric stiffness T / ℓ
+wherever the viscous tension is small beside the elastic one).
+
+The coefficient is a share ζ of critical at a frequency f: a taut bar's axial mode at ω gets
+ζ(ω) = η ω / (2 E), so η A = 2 ζ EA / (2π f) and c_d = 2 ζ EA / (2π f L0). With
+``frequency = "element"`` f is each element's own highest axial frequency 2c/L0 (c = sqrt(EA/m),
+that of two lumped halves), and c_d = ζ sqrt(EA m): ζ times the wave impedance, the same for
+every element of a cable whatever the mesh. A mode of frequency ω then gets ζ ω L0 / (2c),
+which vanishes as the mesh is refined: damping of what the mesh cannot resolve, like the
+numerical dissipation of a generalised-α scheme, but acting on the axial strain only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def axial_rates(conn, X, V, h, kmat, l0, ea, w, ptr, ls, lf, g, edot):
+    """g = ∂e/∂c (n, 3) and ė = g·ċ (n,) of every element, from the solved end forces h and
+    stiffnesses kmat (∂h/∂c) at positions X, velocities V (full dofs)."""
+    d = np.empty(3)
+    for e in range(conn.shape[0]):
+        i = 3 * conn[e, 0]
+        j = 3 * conn[e, 1]
+        L = l0[e]
+        inv = 1.0 / ea[e]
+        for a in range(3):  # ∫ t ds with t(s) = h + (0, 0, w s) - Σ_{s_k < s} f_k
+            d[a] = L * h[e, a]
+        d[2] += 0.5 * w[e] * L * L
+        for k in range(ptr[e], ptr[e + 1]):
+            for a in range(3):
+                d[a] -= lf[k, a] * (L - ls[k])
+        for a in range(3):
+            d[a] = (X[j + a] - X[i + a] - inv * d[a]) * inv
+        rate = 0.0
+        for a in range(3):
+            s = 0.0
+            for b in range(3):
+                s += kmat[e, a, b] * d[b]
+            g[e, a] = s
+            rate += s * (V[j + a] - V[i + a])
+        edot[e] = rate
+
+
+@njit(cache=True)
+def add_forces(conn, cd, g, edot, out):
+    """out (n_dof,) += the element damping forces on the full dofs."""
+    for e in range(conn.shape[0]):
+        i = 3 * conn[e, 0]
+        j = 3 * conn[e, 1]
+        f = cd[e] * edot[e]
+        for a in range(3):
+            out[i + a] -= f * g[e, a]
+            out[j + a] += f * g[e, a]
+
+
+@njit(cache=True)
+def add_residual(conn, cd, g, edot, unknown, res):
+    """res[2 k + 1] += the damping force on the free dof of unknown k (``unknown``: the unknown
+    of each full dof, -1 where the dof is fixed)."""
+    for e in range(conn.shape[0]):
+        i = 3 * conn[e, 0]
+        j = 3 * conn[e, 1]
+        f = cd[e] * edot[e]
+        for a in range(3):
+            ki = unknown[i + a]
+            kj = unknown[j + a]
+            if ki >= 0:
+                res[2 * ki + 1] -= f * g[e, a]
+            if kj >= 0:
+                res[2 * kj + 1] += f * g[e, a]
+
+
+class AxialDamping:
+    """The strain-rate damping of one transient step: coefficients and evaluations."""
+
+    def __init__(self, model, ratio: float, frequency: float | str):
+        el = model.elements
+        mesh = model.mesh
+        self.ratio = float(ratio)
+        self.frequency = frequency
+        if frequency == "element":
+            # ω_e = 2 c / L0: c_d = 2 ζ EA / (ω_e L0) = ζ sqrt(EA m)
+            self.cd = self.ratio * np.sqrt(el.EA * mesh.m)
+            with np.errstate(divide="ignore"):
+                self.f_element = np.sqrt(el.EA / mesh.m) / (np.pi * el.L0)
+        else:
+            self.cd = 2.0 * self.ratio * el.EA / (2.0 * np.pi * float(frequency) * el.L0)
+            self.f_element = None
+        self.cd = np.ascontiguousarray(self.cd, float)
+        ne = el.L0.size
+        self.g = np.zeros((ne, 3))
+        self.edot = np.zeros(ne)
+        self._conn = np.ascontiguousarray(mesh.conn, np.int64)
+        self._model = model
+
+    @classmethod
+    def of(cls, model, step) -> AxialDamping | None:
+        spec = getattr(step, "axial_damping", None)
+        if spec is None:
+            return None
+        return cls(model, spec.ratio, spec.frequency)
+
+    def describe(self) -> str:
+        if self.frequency == "element":
+            f = self.f_element
+            return (f"{100 * self.ratio:g} % of critical at each element's highest axial "
+                    f"frequency ({np.nanmin(f):.4g}-{np.nanmax(f):.4g} Hz)")
+        return f"{100 * self.ratio:g} % of critical at {float(self.frequency):g} Hz"
+
+    def rates(self, X, V, h, kmat) -> None:
+        """g and ė at positions X, velocities V (full dofs) and the solved h, kmat."""
+        el = self._model.elements
+        axial_rates(self._conn, X, V, h, kmat, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf,
+                    self.g, self.edot)
+
+    def add_residual(self, unknown, res) -> None:
+        add_residual(self._conn, self.cd, self.g, self.edot, unknown, res)
+
+    def add_forces(self, out) -> None:
+        add_forces(self._conn, self.cd, self.g, self.edot, out)
+
+    def tension(self) -> np.ndarray:
+        """The viscous tension c_d ė of every element (n,) N, at the last ``rates``."""
+        return self.cd * self.edot
+
+    def velocity_blocks(self) -> np.ndarray:
+        """∂f/∂v (n, 6, 6) at the last ``rates``."""
+        gg = self.cd[:, None, None] * self.g[:, :, None] * self.g[:, None, :]
+        return np.block([[gg, -gg], [-gg, gg]])
