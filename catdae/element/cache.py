@@ -19,7 +19,7 @@ import hashlib
 from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/mass", "element/residual_kernel",
-                  "solvers/axial_damping")
+                  "solvers/axial_damping", "solvers/envelope")
 _STAMP = "catdae-kernels.sha256"
 
 

@@ -36,30 +36,34 @@ from numba import njit
 
 
 @njit(cache=True)
+def element_g(i, j, X, he, ke, L, ea, w, ls, lf, k0, k1, gout):
+    """g = ∂e/∂c (3,) of one element (nodes' first dofs i, j; end force he, stiffness ke)."""
+    inv = 1.0 / ea
+    d0 = L * he[0]
+    d1 = L * he[1]
+    d2 = L * he[2] + 0.5 * w * L * L  # ∫ t ds, t(s) = h + (0, 0, w s) - Σ_{s_k < s} f_k
+    for k in range(k0, k1):
+        d0 -= lf[k, 0] * (L - ls[k])
+        d1 -= lf[k, 1] * (L - ls[k])
+        d2 -= lf[k, 2] * (L - ls[k])
+    d0 = (X[j] - X[i] - inv * d0) * inv
+    d1 = (X[j + 1] - X[i + 1] - inv * d1) * inv
+    d2 = (X[j + 2] - X[i + 2] - inv * d2) * inv
+    for a in range(3):
+        gout[a] = ke[a, 0] * d0 + ke[a, 1] * d1 + ke[a, 2] * d2
+
+
+@njit(cache=True)
 def axial_rates(conn, X, V, h, kmat, l0, ea, w, ptr, ls, lf, g, edot):
     """g = ∂e/∂c (n, 3) and ė = g·ċ (n,) of every element, from the solved end forces h and
     stiffnesses kmat (∂h/∂c) at positions X, velocities V (full dofs)."""
-    d = np.empty(3)
     for e in range(conn.shape[0]):
         i = 3 * conn[e, 0]
         j = 3 * conn[e, 1]
-        L = l0[e]
-        inv = 1.0 / ea[e]
-        for a in range(3):  # ∫ t ds with t(s) = h + (0, 0, w s) - Σ_{s_k < s} f_k
-            d[a] = L * h[e, a]
-        d[2] += 0.5 * w[e] * L * L
-        for k in range(ptr[e], ptr[e + 1]):
-            for a in range(3):
-                d[a] -= lf[k, a] * (L - ls[k])
-        for a in range(3):
-            d[a] = (X[j + a] - X[i + a] - inv * d[a]) * inv
+        element_g(i, j, X, h[e], kmat[e], l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], g[e])
         rate = 0.0
         for a in range(3):
-            s = 0.0
-            for b in range(3):
-                s += kmat[e, a, b] * d[b]
-            g[e, a] = s
-            rate += s * (V[j + a] - V[i + a])
+            rate += g[e, a] * (V[j + a] - V[i + a])
         edot[e] = rate
 
 

@@ -11,9 +11,8 @@ def _tree(tmp_path):
     for name in KERNEL_MODULES:
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / f"{name}.py").write_text(f"# {name}\n")
-    cache = tmp_path / "element" / "__pycache__"
-    cache.mkdir(exist_ok=True)
-    return cache
+        ((tmp_path / name).parent / "__pycache__").mkdir(exist_ok=True)
+    return tmp_path / "element" / "__pycache__"
 
 
 def _leaf(m):
@@ -21,9 +20,18 @@ def _leaf(m):
 
 
 def _fill(cache):
-    names = [f"{_leaf(m)}._k-1.py311.{ext}" for m in KERNEL_MODULES for ext in ("nbi", "nbc")]
+    """Cached kernels of every kernel module in its own folder's __pycache__ (``cache`` is
+    element's), and two files that are not kernels of these modules."""
+    root = cache.parent.parent
+    names = []
+    for m in KERNEL_MODULES:
+        for ext in ("nbi", "nbc"):
+            n = f"{_leaf(m)}._k-1.py311.{ext}"
+            ((root / m).parent / "__pycache__" / n).write_text("x")
+            if (root / m).parent == cache.parent:
+                names.append(n)
     names += ["catenary.cpython-311.pyc", "other._k-1.py311.nbi"]
-    for n in names:
+    for n in names[-2:]:
         (cache / n).write_text("x")
     return names
 
@@ -43,7 +51,8 @@ def test_cached_kernels_go_together_when_one_kernel_source_changes(tmp_path):
     (tmp_path / "element" / "catenary.py").write_text("# catenary, edited\n")
     assert purge_stale(tmp_path)
     for m in KERNEL_MODULES:  # the callers' kernels too, not only catenary's
-        assert not list(cache.glob(f"{_leaf(m)}.*.nb?")), m
+        mcache = (tmp_path / m).parent / "__pycache__"
+        assert not list(mcache.glob(f"{_leaf(m)}.*.nb?")), m
     assert (cache / "other._k-1.py311.nbi").exists()
     assert not purge_stale(tmp_path)
 
