@@ -205,7 +205,7 @@ class Damping:
 class AxialDamping:
     """Strain-rate (Kelvin-Voigt) damping of a transient step: a share ``ratio`` of critical at
     ``frequency`` (Hz), or at each element's highest axial frequency (``"element"``); it acts
-    on the axial strain rate only (docs/theory.md §12)."""
+    on the axial strain rate only (docs/theory.md §13)."""
 
     ratio: float
     frequency: float | Literal["element"] = "element"
