@@ -32,7 +32,8 @@ def _transient_error(run_ds: xr.Dataset, ref: xr.Dataset, label: str) -> float:
 def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     names = list(grid)
     shape = tuple(len(v) for v in grid.values())
-    data = {v: np.full(shape, np.nan) for v in ("wall_time", *_COUNTS, "peak_memory", "error")}
+    data = {v: np.full(shape, np.nan) for v in ("wall_time", *_COUNTS, "peak_memory", "error",
+                                                "peak_tension_error")}
     status = np.full(shape, "", dtype=object)
     ref_ok = ref.attrs.get("status", "completed") == "completed"
     if st.kind == "transient":
@@ -53,6 +54,9 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
             continue
         if st.kind == "transient":
             data["error"][idx] = _transient_error(rec, ref, label)
+            ref_peak = float(ref.attrs.get("peak_tension", math.nan))
+            data["peak_tension_error"][idx] = (float(rec.attrs.get("peak_tension", math.nan))
+                                               / ref_peak - 1.0)
         else:
             f = rec.frequency.values[:n_modes]
             ferr[idx][: f.size] = (f - ref_f[: f.size]) / ref_f[: f.size]
@@ -85,6 +89,10 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
                  for v, (u, ln) in meta.items()}
     variables["status"] = xr.Variable(dims, status, {"long_name": "run status "
                                                      "('completed' or why it stopped)"})
+    if st.kind == "transient":
+        variables["peak_tension_error"] = xr.Variable(dims, data["peak_tension_error"], {
+            "units": "1", "long_name": "relative error of the step's largest tension (its "
+            "envelope tension_max over every accepted step) against the reference's"})
     out = xr.Dataset(variables, coords=coords)
     if st.kind == "modal":
         out = out.assign_coords(mode=xr.Variable("mode", np.arange(1, n_modes + 1),

@@ -32,7 +32,7 @@ from catdae.study.core import (
 )
 from catdae.study.dataset import _assemble
 from catdae.study.store import _clean, _store_read, _store_write
-from catdae.study.worker import _MemoryProbe
+from catdae.study.worker import _MemoryProbe, peak_tension
 
 
 def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
@@ -163,6 +163,8 @@ def _given_reference(reference, st: Step, case: Case) -> xr.Dataset:
             raise StudyError(f"reference: the results have no group {st.name!r}")
         ds = ds[st.name].to_dataset()
     attrs = {"status": str(ds.attrs.get("status", "completed")), "wall_time": math.nan}
+    if st.kind == "transient":
+        attrs["peak_tension"] = peak_tension(ds)
     if st.kind == "modal":
         if "frequency" not in ds:
             raise StudyError("reference: a modal study needs a 'frequency' variable")

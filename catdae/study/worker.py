@@ -59,12 +59,20 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
         return xr.Dataset(attrs=attrs)
     if step.kind == "modal":
         return xr.Dataset({"frequency": ("mode", group.frequency.values)}, attrs=attrs)
+    attrs["peak_tension"] = peak_tension(group)
     labels = point_labels(case_run, [str(n) for n in group.node.values])
     keep = [i for i, lab in enumerate(labels) if lab is not None]
     return xr.Dataset(
         {"displacement": (("time", "point", "axis"), group.displacement.values[:, keep])},
         coords={"time": group.time.values, "point": [labels[i] for i in keep],
                 "axis": list(AXES)}, attrs=attrs)
+
+
+def peak_tension(group: xr.Dataset) -> float:
+    """The largest tension of a transient step, N: its envelope over every accepted step
+    (``tension_max``), or the largest output tension for results without one."""
+    var = group.get("tension_max", group.get("tension"))
+    return float(var.max()) if var is not None and var.size else math.nan
 
 
 def _warm_up(case_run: Case, step: Step) -> None:

@@ -268,3 +268,46 @@ def test_command_line(tmp_path, capsys):
                       "--store", str(tmp_path / "store"), "-o", str(out)])
     assert bad == 2
     assert "no node is common" in capsys.readouterr().err
+
+
+def test_peak_tension_error_shrinks_as_the_tolerance_tightens():
+    """A mass falling onto a rope (the snap of tests/scenes/test_axial_damping.py): the error
+    of the step's largest tension (from the tension envelope) against the reference run
+    shrinks as rtol tightens, and a reference given as results gives the same errors."""
+    text = """
+[materials.rope]
+EA = 1e7
+mass = 0.1
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [0.3, 0.0, -9.5]
+[supports]
+A = "pinned"
+[[cables]]
+name = "c"
+ends = ["A", "B"]
+material = "rope"
+length = 10.0
+elements = 1
+[[point_masses]]
+name = "bob"
+node = "B"
+mass = 1000.0
+[[steps]]
+kind = "transient"
+name = "drop"
+mass_model = "lumped"
+duration = 0.4
+output_interval = 0.05
+"""
+    kw = dict(rtol=[1e-2, 1e-4, 1e-6], atol=[1e-9], scheduler="synchronous")
+    ds = run_study(text, **kw)
+    assert (ds.status.values == "completed").all()
+    err = np.abs(_values(ds, "peak_tension_error"))
+    assert err[0] > err[1] > err[2] and err[2] < 5e-4, err
+    assert ds.peak_tension_error.attrs["units"] == "1"
+    ref_settings = {k: ds.attrs[f"reference_{k}"] for k in study.SETTINGS}
+    ref_case = study.configure(load_case(text), "drop", ref_settings)
+    given = run_study(text, reference=catdae.run(ref_case), **kw)
+    np.testing.assert_allclose(given.peak_tension_error.values, ds.peak_tension_error.values,
+                               rtol=1e-9)
