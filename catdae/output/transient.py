@@ -73,8 +73,20 @@ def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
 
 def note(model: Model, prob) -> str:
     """Advice on the result's accuracy that the run itself found ("" when none)."""
+    if model.mass_model not in ("consistent", "blended"):
+        return ""
     jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
-    if model.mass_model not in ("consistent", "blended") or not jumps:
+    changed = [*prob.step.add, *prob.step.remove]
+    lam2 = getattr(prob, "lambda2_start", 0.0)
+    if not jumps and changed and lam2 > 1.0:
+        return (f"{', '.join(repr(c) for c in changed)} added or removed at the start of the "
+                "step act(s) suddenly: the axial wave that sends (a snap where elements are "
+                "slack) is not fully carried by the consistent catenary mass of elements that "
+                f"take a chord change by sag (element λ² up to {lam2:.3g} here, > 1); "
+                f"mass_model {model.mass_model_setting!r} kept {model.mass_model!r} (the "
+                "paper's scenes depend on it); peak tensions may be underestimated (try "
+                "mass_model = \"lumped\" or \"linear\"; README, Accuracy and known limits)")
+    if not jumps:
         return ""
     t, dv, lam2 = jumps[0]
     return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "

@@ -416,6 +416,9 @@ class TransientProblem:
                               termination="initial state")
         mdata = self.mass_data(conf)
         mff = self.ff(mdata).tocsc()
+        if where == "transient start":  # for the note on loads that come or go (snaps)
+            self.lambda2_start = float(m.element_lambda2(conf[0], self.X.reshape(-1, 3)).max(
+                initial=0.0))
         vs_after = self._supports(t0)[1]
         dvs = vs_after - vs_before
         # a jump, not the round-off of two evaluations of a smooth motion

@@ -297,3 +297,46 @@ def test_envelope_holds_every_output():
     assert ds.tension_max.attrs["units"] == "N"
     # a smooth 1.6 Hz oscillation sampled at 500 Hz: the sampled max is within 1e-4 of it
     np.testing.assert_allclose(ds.tension_max.values, T.max(axis=0), rtol=1e-4)
+
+
+def test_note_on_a_load_removed_from_a_slack_cable():
+    """A load taken off a slack cable acts suddenly: with the default (blended) mass the step's
+    note says the wave it sends is not fully carried, and names the load; with the lumped mass,
+    or on a taut cable, there is nothing to say."""
+    def case(length, mass_model):
+        mm = "" if mass_model is None else f'mass_model = "{mass_model}"\n'
+        return f"""
+[materials.wire]
+EA = 3.4e7
+mass = 5.0
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [10.0, 0.0, 0.0]
+[supports]
+A = "pinned"
+B = "pinned"
+[[cables]]
+name = "c"
+ends = ["A", "B"]
+material = "wire"
+length = {length!r}
+elements = 6
+[[loads]]
+name = "lift"
+node = "c.3"
+force = [0.0, 0.0, 300.0]
+[[steps]]
+kind = "static"
+name = "held"
+[[steps]]
+kind = "transient"
+name = "let go"
+remove = ["lift"]
+duration = 0.01
+output_interval = 0.005
+{mm}"""
+    ds = catdae.run(case(15.0, None))["let go"].to_dataset()
+    assert ds.attrs["mass_model"] == "blended"
+    assert "'lift' added or removed" in ds.attrs["note"] and "lumped" in ds.attrs["note"]
+    assert catdae.run(case(15.0, "lumped"))["let go"].to_dataset().attrs["note"] == ""
+    assert catdae.run(case(9.99, None))["let go"].to_dataset().attrs["note"] == ""
