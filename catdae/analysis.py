@@ -200,9 +200,9 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                "current configuration")
     sol = solve_modal(model, state.X, est, step.modes)
     return results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
-                                 {"solver": sol.solver, "mass_model": model.mass_model,
-                                  "mass_model_setting": model.mass_model_setting,
-                                  "mass_model_choice": model.mass_model_choice,
+                                 {"solver": sol.solver, "mass_model": model.mass_model.name,
+                                  "mass_model_setting": model.mass_model.setting,
+                                  "mass_model_choice": model.mass_model.choice,
                                   "status": "completed"})
 
 

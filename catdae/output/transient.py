@@ -74,7 +74,7 @@ def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
 def note(model: Model, prob) -> str:
     """Advice on the result's accuracy that the run itself found ("" when none)."""
     jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
-    if model.mass_model not in ("consistent", "blended") or not jumps:
+    if not model.mass_model.catenary or not jumps:
         return ""
     t, dv, lam2 = jumps[0]
     return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "

@@ -48,6 +48,7 @@ from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.settings import DampingModel
 from catdae.output.transient import potential
 
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
@@ -106,13 +107,10 @@ class TransientProblem:
         self.jmap_vq = inv[2 * n:2 * n + m]
         self.jmap_vv = inv[2 * n + m:]
         # --- damping
-        self.damping = step.damping
-        self.alpha = self.beta = 0.0
-        if self.damping is not None and self.damping.kind == "rayleigh":
-            self.alpha, self.beta = self.damping.coefficients()
-        self.material = self.damping is not None and self.damping.kind == "material"
-        self.lagrangian = step.inertia == "lagrangian" and (
-            model.mass_model in ("consistent", "blended"))
+        self.damping = DampingModel.of_step(step.damping)
+        self.alpha, self.beta = self.damping.alpha, self.damping.beta
+        self.material = self.damping.material
+        self.lagrangian = step.inertia == "lagrangian" and model.mass_model.catenary
         nd = model.n_dof
         self.m_diag = model.diagonal_mass()
         self.c_diag = model.diagonal_mass(model.mesh.c) if self.material else np.zeros(nd)
@@ -139,16 +137,16 @@ class TransientProblem:
         mm = m.mass_model
         ne = m.mesh.n_elements
         nd = self.n_dof
-        consistent = mm in ("consistent", "blended")
+        consistent = mm.catenary
         self._want_m = consistent
         self._want_c = self.material and consistent
         self._want_dm = self.lagrangian
-        self._scale = 1.0 - m.lumped_fraction if consistent else 1.0
-        self._use_m = mm != "lumped"
-        self._use_c = self.material and mm != "lumped"
-        self._me = (m.linear_element_mass() if mm == "linear" else
+        self._scale = 1.0 - mm.lumped_fraction if consistent else 1.0
+        self._use_m = not mm.lumped
+        self._use_c = self.material and not mm.lumped
+        self._me = (m.linear_element_mass() if mm.linear else
                     np.zeros((ne, 6, 6)) if consistent else self._dummy3)
-        self._ce = (m.linear_element_mass(damping=True) if mm == "linear" and self.material else
+        self._ce = (m.linear_element_mass(damping=True) if mm.linear and self.material else
                     np.zeros((ne, 6, 6)) if self._want_c else self._dummy3)
         self._dm = np.zeros((ne, 3, 6, 6)) if self._want_dm else self._dummy4
         self._fflat = np.zeros((ne, 6))
@@ -161,7 +159,7 @@ class TransientProblem:
         self._Vb = np.zeros(nd)
         self._Ab = np.zeros(nd)
         self._force = np.zeros(nd)
-        damped = self.damping is not None
+        damped = self.damping.damped
         self._v_diag = (self.c_diag + self.alpha * self.m_diag) if damped else np.zeros(nd)
         self._buffers_at = None  # (t, q) whose element state the buffers hold
         self._res_scratch = np.zeros(2 * self.n)
@@ -264,7 +262,7 @@ class TransientProblem:
         state, me, ce, dm = conf
         el = m.elements
         out = np.empty(self.n_dof)
-        damped = self.damping is not None
+        damped = self.damping.damped
         _dynamic_forces(m.edofs, state.h, el._load_total, self._wl0,
                         me if me is not None else self._dummy3, me is not None,
                         ce if ce is not None else self._dummy3, ce is not None, state.K,
@@ -406,7 +404,7 @@ class TransientProblem:
             self.velocity_jumps.append((float(t0), float(np.abs(dvs).max()),
                                         float(lam2.max())))
         v0 = np.array(v0, float)
-        if np.any(dvs) and m.mass_model != "lumped":
+        if np.any(dvs) and not m.mass_model.lumped:
             full = m.pattern.matrix(mdata)
             v0 -= spla.spsolve(mff, full[self.fidx][:, m.fixed] @ dvs)
         V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))

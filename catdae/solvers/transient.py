@@ -114,10 +114,10 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
             "max_order": (order_choice.order if auto else int(step.max_order)),
             "max_order_setting": str(step.max_order),
             "order_choice": order_choice.summary() if auto else "fixed by the step",
-            "mass_model": model.mass_model, "mass_model_setting": model.mass_model_setting,
-            "mass_model_choice": model.mass_model_choice,
+            "mass_model": model.mass_model.name, "mass_model_setting": model.mass_model.setting,
+            "mass_model_choice": model.mass_model.choice,
             "inertia": step.inertia if prob.lagrangian else
-            "paper" if model.mass_model in ("consistent", "blended") else "constant mass",
+            "paper" if model.mass_model.catenary else "constant mass",
             "damping": "none" if step.damping is None else step.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
             "n_outputs": n_valid, "n_restarts": n_restarts, "note": note(model, prob),
