@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from catdae.case.messages import _found, _is_number
+from catdae.case.names import mesh_node, split_mesh_node
 from catdae.case.timefunc import TimeFunction
 from catdae.errors import CaseError
 
@@ -332,7 +333,7 @@ class Case:
             def keep_place(item):
                 if item.node is None or item.node in self.nodes:
                     return item
-                cable, _, k = item.node.rpartition(".")
+                cable, k = split_mesh_node(item.node)
                 c = by_name[cable]
                 if c.length is None:  # form-found: the length is not known yet
                     k_new = int(k) * int(elements) / c.elements
@@ -342,7 +343,7 @@ class Case:
                             f"whose length is found by form-finding; with {elements} elements "
                             "it would fall between mesh nodes: use a multiple of "
                             f"{c.elements} elements"))])
-                    return replace(item, node=f"{cable}.{int(k_new)}")
+                    return replace(item, node=mesh_node(cable, k_new))
                 return replace(item, node=None, cable=cable, s=int(k) * c.length / c.elements)
 
             point_masses = tuple(keep_place(p) for p in point_masses)
