@@ -12,9 +12,12 @@ from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
-from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
-from catdae.case.messages import _found, _is_number
+from pydantic import ValidationError
+
+from catdae.case.limits import size_problems
+from catdae.case.messages import _message
 from catdae.case.names import mesh_node, split_mesh_node
+from catdae.case.schema import _Overrides
 from catdae.case.timefunc import TimeFunction
 from catdae.errors import CaseError
 
@@ -297,21 +300,15 @@ class Case:
         kept at the same place on the cable (its unstrained arc length in the case's mesh).
         Raises ``CaseError`` if a value is invalid.
         """
-        problems: list[tuple[str, str]] = []
-        for key, value in (("rtol", rtol), ("atol", atol)):
-            if value is not None and not (_is_number(value) and 0 < value < math.inf):
-                problems.append((key, f"expected a finite number > 0, found {_found(value)}"))
-        if elements is not None and not (
-            isinstance(elements, numbers.Integral) and not isinstance(elements, bool)
-            and 1 <= elements <= MAX_ELEMENTS_PER_CABLE
-        ):
-            problems.append(("elements", f"expected an integer >= 1 and <= "
-                             f"{MAX_ELEMENTS_PER_CABLE}, found {_found(elements)}"))
-        if mass_model is not None and mass_model not in MASS_MODELS:
-            problems.append(("mass_model", 'expected "auto", "blended", "consistent", '
-                             f'"lumped" or "linear", found {_found(mass_model)}'))
-        if problems:
-            raise CaseError(self.path, problems)
+        given = {"rtol": rtol, "atol": atol, "mass_model": mass_model,
+                 "elements": (int(elements) if isinstance(elements, numbers.Integral)
+                              and not isinstance(elements, bool) else elements)}
+        try:
+            _Overrides.model_validate({k: v for k, v in given.items() if v is not None})
+        except ValidationError as exc:
+            fields = list(_Overrides.model_fields)
+            raise CaseError(self.path, [(str(err["loc"][0]), _message(err, fields, {}))
+                                        for err in exc.errors()]) from None
         steps = tuple(
             replace(s, rtol=float(rtol if rtol is not None else s.rtol),
                     atol=float(atol if atol is not None else s.atol))
