@@ -23,7 +23,7 @@ from catdae.errors import CaseError
 
 AXES = ("x", "y", "z")
 # docs/case-format.md, mass_model
-MASS_MODELS = ("auto", "blended", "consistent", "lumped", "linear")
+
 
 
 class FrozenMap(Mapping):
@@ -293,7 +293,7 @@ class Case:
     def with_overrides(self, rtol: float | None = None, atol: float | None = None,
                        elements: int | None = None, mass_model: str | None = None) -> Case:
         """A new Case with ``rtol``/``atol`` set on every transient step, ``mass_model``
-        (one of ``MASS_MODELS``) on every transient and modal step, and ``elements`` on
+        (one of ``schema.MASS_MODEL_NAMES``) on every transient and modal step, and ``elements`` on
         every cable (``None`` leaves a setting as it is).
 
         With a new ``elements``, a load or point mass placed on a mesh node ``<cable>.<k>`` is

@@ -7,7 +7,7 @@ functions) are validated later, against the model their kind selects.
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
@@ -24,6 +24,7 @@ Name = Annotated[str, Field(min_length=1)]
 # settings a command line may override too (``_Overrides``): one type for both
 Elements = Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)]
 MassModelName = Literal["auto", "blended", "consistent", "lumped", "linear"]
+MASS_MODEL_NAMES = get_args(MassModelName)
 TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from catdae._version import __version__
 from catdae.case import AXES, Case, Step
 from catdae.case.names import mesh_node, split_mesh_node
+from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CatdaeError
 
 SETTINGS = ("rtol", "atol", "elements", "gauss_points", "mass_model", "linear_solver",
@@ -31,7 +32,7 @@ _COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "linear_solver": ("", "linear solver requested"),
     "max_order": ("1", "largest BDF order of IDA"),
 }
-_CHOICES = {"mass_model": ("auto", "blended", "consistent", "lumped", "linear"),
+_CHOICES = {"mass_model": MASS_MODEL_NAMES,
             "linear_solver": ("auto", "band", "sparse", "dense")}
 _COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
 _MEMORY_NAMES = {
