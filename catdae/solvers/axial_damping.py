@@ -149,6 +149,16 @@ class AxialDamping:
         """The viscous tension c_d ė of every element (n,) N, at the last ``rates``."""
         return self.cd * self.edot
 
+    def velocity_data(self, prob, t, y, yp, conf) -> np.ndarray:
+        """CSR data (full dofs) of ∂f/∂v at the state (t, y, yp) of the configuration conf of
+        the TransientProblem prob (the iteration matrix's velocity block)."""
+        V, _ = prob.full_vectors(t, y[1::2], yp[1::2])
+        X = np.empty(prob.n_dof)
+        X[prob.fidx] = y[0::2]
+        X[prob.model.fixed] = prob._supports(t)[0]
+        self.rates(X, V, conf[0].h, conf[0].K)
+        return prob.model.pattern.assemble(self.velocity_blocks())
+
     def velocity_blocks(self) -> np.ndarray:
         """∂f/∂v (n, 6, 6) at the last ``rates``."""
         gg = self.cd[:, None, None] * self.g[:, :, None] * self.g[:, None, :]

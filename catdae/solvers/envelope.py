@@ -19,7 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import NOT_CONVERGED, _solve_batch, _solve_one
+from catdae.element.catenary import NOT_CONVERGED, _solve_one
+from catdae.element.catenary_batch import _solve_batch
 from catdae.solvers.axial_damping import element_g
 
 CARRY = 1e-4  # largest relative change of an end force carried to first order
@@ -177,19 +178,3 @@ class TensionEnvelope:
         dn = first | (tension < self.t_min)
         self.t_min[dn] = tension[dn]
         self.time_min[dn] = t
-
-    def variables(self) -> dict:
-        """The four envelope variables of the step's dataset (dims element, end)."""
-        from catdae.output.results import _var
-        d = ("element", "end")
-        how = "over every accepted integrator step and output"
-        return {
-            "tension_max": _var(d, self.t_max.copy(), "N",
-                                f"largest cable tension at element end, {how}"),
-            "tension_min": _var(d, self.t_min.copy(), "N",
-                                f"smallest cable tension at element end, {how}"),
-            "time_tension_max": _var(d, self.time_max.copy(), "s",
-                                     "time of tension_max on the case's clock"),
-            "time_tension_min": _var(d, self.time_min.copy(), "s",
-                                     "time of tension_min on the case's clock"),
-        }
