@@ -131,6 +131,8 @@ VIOLENT_ROWS = {
     "rtol 1e-3, atol 1e-6": ("", ["--rtol", "1e-3", "--atol", "1e-6"]),
     "rtol 1e-2, atol 1e-4": ("", ["--rtol", "1e-2", "--atol", "1e-4"]),
     "rtol 3e-3, atol 3e-5": ("", ["--rtol", "3e-3", "--atol", "3e-5"]),
+    "rtol 5e-3, atol 1e-4": ("", ["--rtol", "5e-3", "--atol", "1e-4"]),
+    "rtol 5e-3, atol 1e-4, max_order 2": ("max_order = 2", ["--rtol", "5e-3", "--atol", "1e-4"]),
     "rtol 1e-3, axial 0.5 % (element)": ('axial_damping = { ratio = 0.005 }',
                                           ["--rtol", "1e-3", "--atol", "1e-6"]),
     "rtol 1e-3, axial 5 % (element)": ('axial_damping = { ratio = 0.05 }',
