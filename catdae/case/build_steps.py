@@ -199,12 +199,7 @@ class _StepsPass:
     def axial_damping(self, raw: dict | None, step_where: tuple) -> AxialDamping | None:
         if raw is None:
             return None
-        where = step_where + ("axial_damping",)
-        if not isinstance(raw, dict):
-            self.problem(where, "expected a table { ratio = .., frequency = .. } (ratio: share "
-                         "of critical, frequency: Hz or \"element\"), found "
-                         f"{_found(raw)}")
-            return None
+        where = step_where + ("axial_damping",)  # a table: the schema's TomlTable
         v, complete = self.validate(_AxialDamping, raw, where)
         if v is None or not complete:
             return None
