@@ -234,3 +234,69 @@ def test_taut_cable_in_steady_wind_decays_at_the_quasi_steady_rate(direction, sh
     assert np.abs(q - decay(t, *popt)).max() < 0.05 * abs(popt[0])
     expected = share * rho * cd * d * U / (2.0 * m * omega)
     assert zeta == pytest.approx(expected, rel=0.05)
+
+
+# ------------------------------------------------------------------------------------------------
+# the bundled cases
+# ------------------------------------------------------------------------------------------------
+def _case(name: str, duration: float, output_interval: float):
+    import dataclasses
+
+    from repo_paths import CASES
+
+    case = load_case(CASES / name)
+    steps = tuple(dataclasses.replace(s, duration=duration, output_interval=output_interval)
+                  if s.kind == "transient" else s for s in case.steps)
+    return catdae.run(dataclasses.replace(case, steps=steps), progress=False)
+
+
+def test_jumper_case_still_water_and_its_waves():
+    """cases/jumper_current_waves.toml: in still water (t = 0, current and waves ramped from
+    0) the jumper is the elastic catenary of its submerged weight; after the ramp the surface
+    elevation written above its nodes is the Airy wave (H/2) cos(k x - ω t) with k from the
+    finite-depth dispersion ω² = g k tanh(k h), solved here on its own."""
+    from scipy.optimize import brentq
+
+    tree = _case("jumper_current_waves.toml", 12.0, 0.5)
+    st = tree["still"].to_dataset()
+    g, rho, d = 9.807, 1000.0, 0.396
+    w_sub = 165.0 * g - rho * g * math.pi * d * d / 4.0
+    ref = irvine_catenary_inclined_3d((-100.0, 0.0, -55.0), (0.0, 0.0, -5.0), 170.0, 500.0e6,
+                                      w_sub)
+    X = st.position.sel(node=[f"jumper.{k}" for k in range(1, 20)]).values
+    np.testing.assert_allclose(X, ref["x"](np.arange(1, 20) * 170.0 / 20), rtol=0, atol=1e-9 * 170)
+    ds = tree["waves"].to_dataset()
+    omega = 2 * math.pi / 10.0
+    k = brentq(lambda k: g * k * math.tanh(k * 100.0) - omega**2, 1e-6, 10.0, xtol=1e-15)
+    late = ds.time.values >= 10.0
+    t = ds.time.values[late][:, None]
+    x = ds.position.sel(axis="x").values[late]
+    np.testing.assert_allclose(ds.surface_elevation.values[late], 2.0 * np.cos(k * x - omega * t),
+                               rtol=0, atol=1e-9)
+    # the water moves the jumper: the velocity written at the top node is the wave's and the
+    # current's there (5 m below the surface, deep-ish water: the orbit is nearly circular)
+    assert np.isfinite(ds.fluid_velocity.values).all()
+    assert float(np.abs(ds.displacement.values).max()) > 0.1
+
+
+def test_conductor_gust_case_calm_then_swung_and_back():
+    """cases/conductor_wind_gust.toml: calm at t = 0 (the gust's factor is 0) the span is the
+    elastic catenary of its weight; the gust swings it downwind (+y), where the wind itself
+    damps the swing (aerodynamic damping, no damping setting: the swing settles while the wind
+    holds), and it swings back once the gust has passed (in calm air only the weak quadratic
+    drag of its own motion remains)."""
+    tree = _case("conductor_wind_gust.toml", 60.0, 0.5)
+    st = tree["calm"].to_dataset()
+    ref = irvine_catenary_inclined_3d((0.0, 0.0, 25.0), (300.0, 0.0, 25.0), 300.5, 3.0e7,
+                                      1.6 * 9.81)
+    X = st.position.sel(node=[f"span.{k}" for k in range(1, 20)]).values
+    np.testing.assert_allclose(X, ref["x"](np.arange(1, 20) * 300.5 / 20), rtol=0,
+                               atol=1e-9 * 300)
+    ds = tree["gust"].to_dataset()
+    y = ds.displacement.sel(node="span.10", axis="y").values
+    t = (ds.time.values - ds.time.values[0]) / np.timedelta64(1, "s") \
+        if ds.time.dtype.kind == "M" else ds.time.values
+    early, late = y[(t >= 10) & (t <= 13)], y[(t >= 20) & (t <= 25)]
+    assert late.mean() > 3.0  # swung downwind
+    assert np.ptp(late) < 0.2 * np.ptp(early)  # and settled while the wind holds
+    assert abs(y[t >= 40].mean()) < 0.2 * late.mean()  # back after the gust
