@@ -19,7 +19,7 @@ import hashlib
 from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/mass", "element/residual_kernel",
-                  "element/fluid_kernel")
+                  "element/fluid_kernel", "element/fluid_kinematics")
 _STAMP = "catdae-kernels.sha256"
 
 

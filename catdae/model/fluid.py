@@ -21,13 +21,13 @@ import numpy as np
 from catdae.case import Case
 from catdae.case.fluid import Waves
 from catdae.case.timefunc import Ramp
-from catdae.element.fluid_kernel import (
+from catdae.element.fluid_kernel import fluid_pass
+from catdae.element.fluid_kinematics import (
     LOG,
     NONE,
     POWER,
     PROFILE,
     UNIFORM,
-    fluid_pass,
     point_kinematics,
 )
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from catdae.case.fluid import Waves
-from catdae.element.fluid_kernel import wave_kinematics
+from catdae.element.fluid_kinematics import wave_kinematics
 from catdae.model.fluid import dispersion, wave_components
 
 from scene_toml import cable_scene, static_step
