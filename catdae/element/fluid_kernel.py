@@ -13,7 +13,50 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.fluid_kinematics import _profile, wave_kinematics
+from catdae.element.fluid_kinematics import _profile, surface_elevation, wave_kinematics
+
+
+@njit(cache=True)
+def _buoyancy(e, i, j, X, t, c, b, surface, amp, omega, wk, cosb, sinb, phase, ramp, want_jac,
+              out, kx):
+    """Buoyancy of element e (c = ρ g A L0 N) on its nodes, integrated exactly along the
+    straight chord over the part below the surface (the height above the surface, d(ξ) =
+    (1 - ξ) d_i + ξ d_j, linear between the nodes' heights above it), less the share ``b`` (1 or
+    0) its weight already holds: ∫ N_a χ dξ in closed form, so that it is continuous in the
+    node positions (docs/theory.md §13.1); with ``want_jac`` its derivative into ``kx``."""
+    ei, gxi, gyi = surface_elevation(X[i], X[i + 1], t, amp, omega, wk, cosb, sinb, phase,
+                                     ramp)
+    ej, gxj, gyj = surface_elevation(X[j], X[j + 1], t, amp, omega, wk, cosb, sinb, phase,
+                                     ramp)
+    di = X[i + 2] - surface - ei
+    dj = X[j + 2] - surface - ej
+    i1 = i2 = 0.0
+    d1_di = d1_dj = d2_di = d2_dj = 0.0
+    if di <= 0.0 and dj <= 0.0:
+        i1 = i2 = 0.5
+    elif di <= 0.0 or dj <= 0.0:
+        den = di - dj
+        xs = di / den  # where the chord meets the surface
+        xs_di = -dj / (den * den)
+        xs_dj = di / (den * den)
+        if di <= 0.0:  # wet on [0, ξ*]
+            i1, i2 = xs - 0.5 * xs * xs, 0.5 * xs * xs
+            g1, g2 = 1.0 - xs, xs
+        else:  # wet on [ξ*, 1]
+            i1, i2 = 0.5 * (1.0 - xs) * (1.0 - xs), 0.5 - 0.5 * xs * xs
+            g1, g2 = -(1.0 - xs), -xs
+        d1_di, d1_dj, d2_di, d2_dj = g1 * xs_di, g1 * xs_dj, g2 * xs_di, g2 * xs_dj
+    out[i + 2] -= c * (i1 - 0.5 * b)
+    out[j + 2] -= c * (i2 - 0.5 * b)
+    if want_jac and (d1_di != 0.0 or d1_dj != 0.0):
+        # ∂d_i/∂x_i = (-∂η/∂x, -∂η/∂y, 1) at node i, likewise j
+        for a in range(3):
+            dd_i = 1.0 if a == 2 else (-gxi if a == 0 else -gyi)
+            dd_j = 1.0 if a == 2 else (-gxj if a == 0 else -gyj)
+            kx[e, 2, a] -= c * d1_di * dd_i
+            kx[e, 2, 3 + a] -= c * d1_dj * dd_j
+            kx[e, 5, a] -= c * d2_di * dd_i
+            kx[e, 5, 3 + a] -= c * d2_dj * dd_j
 
 
 @njit(cache=True)
@@ -25,7 +68,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
     """Fluid forces on the nodes of every element at time t.
 
     ``out`` (n_dof,) receives M_a A - f: the added-mass force minus the fluid force (buoyancy
-    of the Gauss points not already in the element's weight, drag, Froude-Krylov), i.e. what the
+    not already in the element's weight, drag, Froude-Krylov), i.e. what the
     fluid adds to the dynamic force M A + C V + F - P of the residual. ``ma`` (n_elem, 6, 6)
     receives the element added-mass matrices; with ``want_jac``, ``kx`` and ``kv`` (n_elem, 6, 6)
     the derivatives of ``out`` with respect to the positions and velocities of the element's
@@ -81,6 +124,9 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                     kx[e, r, c] = 0.0
                     kv[e, r, c] = 0.0
         bsum[0, 0] = bsum[0, 1] = bsum[1, 0] = bsum[1, 1] = 0.0
+        if rho_w > 0.0 and area[e] > 0.0:
+            _buoyancy(e, i, j, X, t, rho_w * g * area[e] * l0[e], in_weight[e], surface, amp,
+                      omega, wk, cosb, sinb, phase, ramp, want_jac, out, kx)
         for q in range(ng):
             wq = gw[e, q]
             if wq == 0.0:
@@ -125,12 +171,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
             else:
                 rho = 0.0
             wl = wq * l0[e]  # m of unstrained line at this point
-            # buoyancy of the point, less what the element's weight already holds
-            fb = rho_w * g * area[e] * ((1.0 if wet else 0.0) - in_weight[e])
             if rho == 0.0:
-                if fb != 0.0:
-                    out[i + 2] -= wl * n1 * fb
-                    out[j + 2] -= wl * n2 * fb
                 continue
             # relative velocity, split along τ
             ut = 0.0
@@ -153,7 +194,6 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                 if wet:
                     fg[a] += fk * ((1.0 + can[e]) * (af[a] - aft * tau[a])
                                    + (1.0 + caa[e]) * aft * tau[a])
-            fg[2] += fb
             for a in range(3):
                 out[i + a] -= wl * n1 * fg[a]
                 out[j + a] -= wl * n2 * fg[a]

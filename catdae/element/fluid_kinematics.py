@@ -66,6 +66,23 @@ def _depth_ratios(k, z, depth):
 
 
 @njit(cache=True)
+def surface_elevation(x, y, t, amp, omega, wk, cosb, sinb, phase, ramp):
+    """(η, ∂η/∂x, ∂η/∂y): the wave elevation above the still level at (x, y) and its slope."""
+    eta = 0.0
+    gx = 0.0
+    gy = 0.0
+    for c in range(amp.shape[0]):
+        kx = wk[c] * cosb[c]
+        ky = wk[c] * sinb[c]
+        th = kx * x + ky * y - omega[c] * t + phase[c]
+        eta += amp[c] * np.cos(th)
+        s = amp[c] * np.sin(th)
+        gx -= s * kx
+        gy -= s * ky
+    return ramp * eta, ramp * gx, ramp * gy
+
+
+@njit(cache=True)
 def wave_kinematics(x, y, z, t, surface, depth, amp, omega, wk, cosb, sinb, phase, ramp, dramp,
                     u, a, gu, ga):
     """Surface elevation above the still level at (x, y) and, at height z (local z relative to

@@ -60,6 +60,38 @@ def test_submerged_line_is_the_catenary_of_the_submerged_weight(ne):
     assert abs(air["h"][0] - ref["h"][0]) > 1e3 * 1e-9 * scale
 
 
+def test_line_crossing_the_surface_converges_to_the_piecewise_catenary():
+    """A line from 40 m deep to 10 m above the still water: under water it weighs w - ρ g A,
+    above w. The exact static state is the elastic catenary with those two weights, switching
+    where it meets the surface (tests/reference.py's piecewise catenary, the switch found by
+    root-finding). Elements under water hold the buoyancy in their weight; the one crossing the
+    surface gets it integrated on its chord (docs/theory.md §13.1): the end forces converge at
+    about second order."""
+    from scipy.optimize import brentq
+
+    from reference import piecewise_catenary
+
+    L0, EA, w, d = 80.0, 1e9, 500.0, 0.2
+    ws = w - RHO * G * math.pi * d * d / 4
+
+    def ref_of(sc):
+        return piecewise_catenary(60.0, 50.0, EA, [(sc, ws), (L0 - sc, w)])
+
+    sc = brentq(lambda s: ref_of(s)["position"](s)[1] - 40.0, 30.0, 75.0, xtol=1e-13)
+    ref = ref_of(sc)
+    errs = []
+    for ne in (5, 10, 20, 40, 80):
+        text = cable_scene(A=(0.0, 0.0, -40.0), B=(60.0, 0.0, 10.0), L0=L0, EA=EA, mass=w / G,
+                           weight=w, elements=ne, extra=_water(), steps=static_step())
+        text = text.replace("weight = ", f"diameter = {d}\nweight = ")
+        r = catdae.run(load_case(text), progress=False)["st"].to_dataset().reaction
+        ra = r.sel(node="A").values
+        errs.append(max(abs(-ra[0] - ref["H"]) / ref["H"], abs(-ra[2] - ref["V_i"]) / ref["H"]))
+    rate = -np.polyfit(np.log([5, 10, 20, 40, 80]), np.log(errs), 1)[0]
+    assert rate > 1.6, (rate, errs)
+    assert errs[-1] < 1e-5, errs
+
+
 # ------------------------------------------------------------------------------------------------
 # added mass: transverse modes of a neutrally buoyant taut line
 # ------------------------------------------------------------------------------------------------
@@ -143,6 +175,7 @@ def _problem(extra: str, A, B, mass_model: str):
 
 @pytest.mark.parametrize("extra, ends, mass_model", [
     (_WAVY, ((0.0, 0.0, -150.0), (100.0, 20.0, -40.0)), "blended"),
+    (_WAVY + _WINDY, ((0.0, 0.0, -60.0), (100.0, 20.0, 20.0)), "blended"),  # through the surface
     (_WAVY, ((0.0, 0.0, -150.0), (100.0, 20.0, -40.0)), "lumped"),
     (_WINDY, ((0.0, 0.0, 60.0), (100.0, 20.0, 90.0)), "consistent"),
 ])
