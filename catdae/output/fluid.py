@@ -19,6 +19,8 @@ def with_fluid(ds: xr.Dataset, fluid: Fluid, times: np.ndarray, X: np.ndarray) -
         if np.all(np.isfinite(X[k])):
             eta[k], vel[k] = fluid.kinematics(X[k], float(t))
     out = ds.copy()
+    if fluid.water is not None:
+        out.attrs["water_surface"] = float(fluid.surface)  # m, z of the still-water level
     out["fluid_velocity"] = _var(("time", "node", "axis"), vel, "m/s",
                                  "velocity of the water (below the surface) or the air at the node")
     if fluid.waves is not None:
