@@ -1,4 +1,4 @@
-"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §13).
+"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §14).
 
 A Kelvin-Voigt material carries, besides its elastic tension, a viscous tension η A ε̇ on the
 rate of axial strain only. An element's strain is that of its catenary: the elastic elongation
@@ -99,7 +99,7 @@ def add_residual(conn, cd, g, edot, unknown, res):
 class AxialDamping:
     """The strain-rate damping of one transient step: coefficients and evaluations."""
 
-    def __init__(self, model, ratio: float, frequency: float | str):
+    def __init__(self, model, ratio: float, frequency: float | str, fidx=None):
         el = model.elements
         mesh = model.mesh
         self.ratio = float(ratio)
@@ -118,13 +118,19 @@ class AxialDamping:
         self.edot = np.zeros(ne)
         self._conn = np.ascontiguousarray(mesh.conn, np.int64)
         self._model = model
+        # the unknown of each full dof (-1 where fixed), for the residual
+        self._unknown = np.full(model.n_dof, -1, np.int64)
+        if fidx is not None:
+            self._unknown[fidx] = np.arange(len(fidx))
 
     @classmethod
-    def of(cls, model, step) -> AxialDamping | None:
+    def of(cls, model, step, fidx=None) -> AxialDamping | None:
+        """The damping a transient step asks for (None: none); ``fidx``: the full dof of
+        each unknown of the residual."""
         spec = getattr(step, "axial_damping", None)
         if spec is None:
             return None
-        return cls(model, spec.ratio, spec.frequency)
+        return cls(model, spec.ratio, spec.frequency, fidx)
 
     def describe(self) -> str:
         if self.frequency == "element":
@@ -139,11 +145,22 @@ class AxialDamping:
         axial_rates(self._conn, X, V, h, kmat, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf,
                     self.g, self.edot)
 
-    def add_residual(self, unknown, res) -> None:
-        add_residual(self._conn, self.cd, self.g, self.edot, unknown, res)
+    def add_residual(self, res) -> None:
+        """res (interleaved q, v rows of the unknowns) += the forces at the last ``rates``."""
+        add_residual(self._conn, self.cd, self.g, self.edot, self._unknown, res)
 
-    def add_forces(self, out) -> None:
+    def add_forces(self, out, X=None, V=None, state=None) -> None:
+        """out (n_dof,) += the forces, at (X, V, state.h, state.K) when given, else at the
+        last ``rates``."""
+        if state is not None:
+            self.rates(X, V, state.h, state.K)
         add_forces(self._conn, self.cd, self.g, self.edot, out)
+
+    def add_to_output(self, f, tension):
+        """The forces into f (n_dof,) and the viscous tension onto the end tensions (n, 2),
+        at the last ``rates`` (an output state)."""
+        add_forces(self._conn, self.cd, self.g, self.edot, f)
+        return tension + self.tension()[:, None]
 
     def tension(self) -> np.ndarray:
         """The viscous tension c_d ė of every element (n,) N, at the last ``rates``."""
