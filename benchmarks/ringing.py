@@ -126,6 +126,8 @@ PENDULUM_ROWS = {
     "default": "",
     "axial 50 % (element)": 'axial_damping = { ratio = 0.5, frequency = "element" }',
     "axial 5 % (element)": 'axial_damping = { ratio = 0.05, frequency = "element" }',
+    "rtol 1e-4, atol 1e-6": "rtol = 1e-4\natol = 1e-6",
+    "rtol 1e-4, atol 1e-6, axial 5 %": "rtol = 1e-4\natol = 1e-6\naxial_damping = { ratio = 0.05 }",
 }
 VIOLENT_ROWS = {
     "rtol 1e-3, atol 1e-6": ("", ["--rtol", "1e-3", "--atol", "1e-6"]),
