@@ -43,7 +43,7 @@ from reference import (
     taut_string_frequencies,
 )
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene
+from scene_toml import cable_scene, static_step
 
 G = 9.81
 
@@ -663,30 +663,9 @@ def test_violent_example2_work_energy_balance(tmp_path, mass_model, dt):
 # ------------------------------------------------------------------------------------------------
 # bad input through the command line
 # ------------------------------------------------------------------------------------------------
-BASE = """title = "base"
-[materials.m]
-EA = 1000000.0
-mass = 1.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 11.0
-elements = 2
-[[loads]]
-name = "p"
-node = "c.1"
-force = [0.0, 0.0, -1.0]
-[[steps]]
-kind = "static"
-name = "s"
-"""
+BASE = cable_scene(title="base", B=(10.0, 0.0, 0.0), L0=11.0, EA=1.0e6, mass=1.0, elements=2,
+                   extra=node_load("p", "c.1", (0.0, 0.0, -1.0)),
+                   steps=static_step("s")).lstrip("\n")  # the EA line is line 3
 
 
 def _edit(old, new):
