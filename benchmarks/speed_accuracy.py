@@ -43,60 +43,19 @@ sys.path.insert(0, str(HERE))
 
 import opensees_compare as oc  # noqa: E402
 import transient_speed as ts  # noqa: E402
+from bench_scene import hundred_metre_cable  # noqa: E402
 
 import catdae  # noqa: E402
 from catdae.case import case_from_dict  # noqa: E402
 
 DURATION = 10.0
 TARGETS = (1e-2, 2e-3)  # m
-CASE = """
-title = "Issue 11 benchmark: 100 m cable, end B moving along the span"
-gravity = 9.81
-
-[materials.m]
-EA = 1.0e8
-mass = {mass!r}
-weight = 100.0
-
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [100.0, 0.0, 0.0]
-
-[supports]
-A = "pinned"
-B = "pinned"
-
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 102.0
-elements = {elements}
-gauss_points = 3
-
-[[support_motions]]
-node = "B"
-x = {{ kind = "cosine", amplitude = -0.05, frequency = 0.5, offset = 0.05 }}
-
-[[steps]]
-kind = "static"
-name = "initial"
-
-[[steps]]
-kind = "transient"
-name = "motion"
-duration = {duration!r}
-output_interval = 0.01
-rtol = {rtol!r}
-atol = {atol!r}
-mass_model = "{mass_model}"
-"""
-
-
 def case_text(n: int, rtol: float, mass_model: str = "blended", duration: float = DURATION,
               max_order: str | int = "auto"):
-    text = CASE.format(mass=100.0 / 9.81, elements=n, duration=duration, rtol=rtol,
-                       atol=rtol * 1e-2, mass_model=mass_model)
+    text = hundred_metre_cable(
+        title="Issue 11 benchmark: 100 m cable, end B moving along the span", elements=n,
+        node="B", axis="x", amplitude=0.05, duration=duration, output_interval=0.01, rtol=rtol,
+        atol=rtol * 1e-2, mass_model=mass_model)
     if max_order != "auto":
         text = text.replace(f'mass_model = "{mass_model}"',
                             f'mass_model = "{mass_model}"\nmax_order = {int(max_order)}')
