@@ -55,3 +55,19 @@ output_interval = {output_interval!r}
 rtol = {rtol!r}
 atol = {atol!r}
 {mm}"""
+
+
+def opensees_job(st, ne: int, motion=None, **more) -> dict:
+    """The OpenSees model (opensees_compare.py's worker) of the ne-element cable, its nodes at
+    catdae's static equilibrium ``st`` (the dataset of the step "initial"); ``motion``: (node
+    name, axis index, amplitude) of the moving support when not the worker's default; ``more``:
+    error_tol, duration, ... added as given."""
+    order = {str(n): k for k, n in enumerate(st.node.values)}
+    if motion is not None:
+        more["motion"] = [order[motion[0]], *motion[1:]]
+    chain = ["A"] + [f"c.{k}" for k in range(1, ne)] + ["B"]
+    conn = [[order[chain[k]], order[chain[k + 1]]] for k in range(ne)]
+    return {"X": st.position.values.tolist(), "conn": conn,
+            "supports": [order["A"], order["B"]], "mid": order[f"c.{ne // 2}"],
+            "EA": 1.0e8, "weight": -100.0, "rho": MASS, "L0e": [102.0 / ne] * ne,
+            "newton_tol": 1e-10, "ne": ne, **more}

@@ -43,7 +43,7 @@ sys.path.insert(0, str(HERE))
 
 import opensees_compare as oc  # noqa: E402
 import transient_speed as ts  # noqa: E402
-from bench_scene import hundred_metre_cable  # noqa: E402
+from bench_scene import hundred_metre_cable, opensees_job  # noqa: E402
 
 import catdae  # noqa: E402
 from catdae.case import case_from_dict  # noqa: E402
@@ -104,16 +104,8 @@ def ops_job(n: int) -> dict:
     """The OpenSees model on n elements, its nodes at catdae's static equilibrium."""
     tree = catdae.run(case_from_dict(tomllib.loads(case_text(n, 1e-4, duration=0.01))),
                       progress=False)
-    st = tree["initial"].ds
-    nodes = [str(v) for v in st.node.values]
-    order = {v: k for k, v in enumerate(nodes)}
-    chain = ["A"] + [f"c.{k}" for k in range(1, n)] + ["B"]
-    conn = [[order[chain[k]], order[chain[k + 1]]] for k in range(n)]
-    return {"X": st.position.values.tolist(), "conn": conn,
-            "supports": [order["A"], order["B"]], "mid": order[f"c.{n // 2}"],
-            "motion": [order["B"], 1, 0.05],
-            "EA": 1.0e8, "weight": -100.0, "rho": 100.0 / 9.81, "L0e": [102.0 / n] * n,
-            "error_tol": oc.ERROR_TOL, "duration": DURATION, "newton_tol": 1e-10, "ne": n}
+    return opensees_job(tree["initial"].ds, n, motion=("B", 1, 0.05), error_tol=oc.ERROR_TOL,
+                        duration=DURATION)
 
 
 def run_ops(job: dict, dt: float, env: dict) -> dict:
