@@ -97,41 +97,42 @@ def assert_blocks_close(J, fd, cols, rtol):
 
 
 MASS_MODELS = ["consistent", "blended", "lumped", "linear"]
+T, CJ = 0.05, 40.0
+
+
+def matrices(mass_model, damping, moving):
+    """(problem, J, its finite differences, J with the acceleration (at rest) or the velocity
+    (moving) set to zero at the same positions)."""
+    prob = problem(mass_model, damping)
+    y, yp = state(prob, moving)
+    J = analytic(prob, T, y, yp, CJ)
+    fd = fd_iteration_matrix(prob, T, y, yp, CJ)
+    y0, yp0 = y.copy(), yp.copy()
+    if moving:
+        y0[1::2] = 0.0
+        yp0[0::2] = 0.0
+    else:
+        yp0[1::2] = 0.0
+    return prob, J, fd, analytic(prob, T, y0, yp0, CJ)
 
 
 @pytest.mark.parametrize("damping", ["rayleigh", "material"])
 @pytest.mark.parametrize("mass_model", MASS_MODELS)
 def test_iteration_matrix_at_rest_is_the_derivative_of_the_residual(mass_model, damping):
-    prob = problem(mass_model, damping)
-    t, cj = 0.05, 40.0
-    y, yp = state(prob, moving=False)
-    J = analytic(prob, t, y, yp, cj)
-    fd = fd_iteration_matrix(prob, t, y, yp, cj)
+    prob, J, fd, J0 = matrices(mass_model, damping, moving=False)
     assert_blocks_close(J, fd, slice(None), 1e-7)  # measured: < 1e-9
-    # the acceleration matters: ∂(M(q) a)/∂q is in J for the catenary masses
-    if prob.lagrangian:
-        y2, yp2 = y.copy(), yp.copy()
-        yp2[1::2] = 0.0
-        J0 = analytic(prob, t, y2, yp2, cj)
+    if prob.lagrangian:  # the acceleration matters: ∂(M(q) a)/∂q is in J
         assert np.abs(J - J0).max() > 1e-3 * np.abs(J).max()
 
 
 @pytest.mark.parametrize("damping", ["rayleigh", "material"])
 @pytest.mark.parametrize("mass_model", MASS_MODELS)
 def test_velocity_columns_of_the_iteration_matrix_while_moving(mass_model, damping):
-    prob = problem(mass_model, damping)
-    t, cj = 0.05, 40.0
-    y, yp = state(prob, moving=True)
-    J = analytic(prob, t, y, yp, cj)
-    fd = fd_iteration_matrix(prob, t, y, yp, cj)
+    prob, J, fd, J0 = matrices(mass_model, damping, moving=True)
     assert_blocks_close(J, fd, slice(1, None, 2), 1e-7)  # measured: < 3e-9
     if prob.lagrangian:  # the velocity terms are there, and large against that tolerance
-        y0, yp0 = y.copy(), yp.copy()
-        y0[1::2] = 0.0
-        yp0[0::2] = 0.0
-        J0 = analytic(prob, t, y0, yp0, cj)
         assert np.abs(J - J0)[1::2, 1::2].max() > 1e-2 * np.abs(fd[1::2, 1::2]).max()
     # the kinematic rows r_q = q' - v: exactly c_j I and -I
     n = prob.n
-    np.testing.assert_array_equal(J[0::2, 0::2], cj * np.eye(n))
+    np.testing.assert_array_equal(J[0::2, 0::2], CJ * np.eye(n))
     np.testing.assert_array_equal(J[0::2, 1::2], -np.eye(n))
