@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import catdae
+from catdae.case.names import mesh_node, split_mesh_node
 from catdae.model.mesh import build_mesh
 
 from reference import irvine_catenary_inclined_3d
@@ -65,6 +66,13 @@ def test_names_and_numbering():
     np.testing.assert_allclose(mesh.s_start, [0.0, 2.2, 4.4, 0.0, 3.2])
     for k, name in enumerate(mesh.node_names):
         assert mesh.node_index(name) == k
+    # an interior node's name parses back to its cable and its place along it
+    for i in (1, 2, 5):
+        cable_name, k = split_mesh_node(mesh.node_names[i])
+        assert cable_name == mesh.cable_names[mesh.cable_of_node[i]]
+        le = {"a": 2.2, "b": 3.2}[cable_name]
+        assert int(k) * le == pytest.approx(mesh.s_node[i], rel=1e-14)
+        assert mesh_node(cable_name, int(k)) == mesh.node_names[i]
     # element k of a cable joins its nodes k-1 and k (named ends at the two extremes)
     for e, name in enumerate(mesh.element_names):
         c, k = name.split(".")
