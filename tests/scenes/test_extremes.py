@@ -36,6 +36,7 @@ import catdae
 import catdae.analysis
 from catdae.cli import main
 
+import scene_toml
 from reference import (
     irvine_catenary,
     irvine_catenary_inclined_3d,
@@ -43,7 +44,7 @@ from reference import (
     taut_string_frequencies,
 )
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, static_step
+from scene_toml import cable_scene, load, modal_step, static_step, transient_step
 
 G = 9.81
 
@@ -51,15 +52,6 @@ G = 9.81
 # ------------------------------------------------------------------------------------------------
 # scenes as TOML text
 # ------------------------------------------------------------------------------------------------
-def _f(x) -> str:
-    """A TOML float (also for numpy scalars)."""
-    return repr(float(x))
-
-
-def _vec(v) -> str:
-    return "[" + ", ".join(_f(x) for x in v) + "]"
-
-
 def scene(*, B, L0, EA, mass, weight=None, elements=4, A=(0.0, 0.0, 0.0), supports=("A", "B"),
           extra="", steps="") -> str:
     """One cable c from node A to node B (both pinned unless ``supports`` says otherwise)."""
@@ -68,31 +60,23 @@ def scene(*, B, L0, EA, mass, weight=None, elements=4, A=(0.0, 0.0, 0.0), suppor
                        steps=steps)
 
 
-STATIC = '[[steps]]\nkind = "static"\nname = "static"\n'
+STATIC = static_step("static")
 
 
 def modal(n: int) -> str:
-    return f'[[steps]]\nkind = "modal"\nname = "modes"\nmodes = {n}\n'
+    return modal_step(n)
 
 
 def transient(duration, dt, *, rtol=1e-8, atol=1e-10, remove=()) -> str:
-    return f"""[[steps]]
-kind = "transient"
-name = "dyn"
-remove = {list(remove)!r}
-duration = {_f(duration)}
-output_interval = {_f(dt)}
-rtol = {_f(rtol)}
-atol = {_f(atol)}
-"""
+    return transient_step("dyn", duration, dt, rtol=rtol, atol=atol, remove=list(remove))
 
 
 def point_mass(name, s, m) -> str:
-    return f'[[point_masses]]\nname = "{name}"\ncable = "c"\ns = {_f(s)}\nmass = {_f(m)}\n'
+    return scene_toml.point_mass(name, m, cable="c", s=s)
 
 
 def node_load(name, node, force) -> str:
-    return f'[[loads]]\nname = "{name}"\nnode = "{node}"\nforce = {_vec(force)}\n'
+    return load(name, force, node=node)
 
 
 def assert_sound(tree, supported=("A", "B")):
