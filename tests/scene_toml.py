@@ -164,3 +164,15 @@ def transient_step(name: str, duration, output_interval, *, rtol, atol, remove=N
     return (f'[[steps]]\nkind = "transient"\nname = "{name}"\n{rm}'
             f"duration = {num(duration)}\noutput_interval = {num(output_interval)}\n"
             f"rtol = {num(rtol)}\natol = {num(atol)}\n" + _block(extra))
+
+
+def long_transient(duration=1000.0) -> str:
+    """A weightless taut cable (chord 10 m, 10 % strain, 2 elements) pushed sideways at c.1 by
+    1 N (load "push") in the static step "static", then released for ``duration`` seconds in the
+    transient "dyn" (about 200 s of wall time per 1000 s simulated: a run of it is always
+    interrupted long before its end)."""
+    return cable_scene(
+        B=(10.0, 0.0, 0.0), L0=10.0 / 1.1, EA=1e4, mass=2.0, weight=0.0, elements=2,
+        extra=load("push", [0.0, 1.0, 0.0], node="c.1"),
+        steps=static_step("static") + transient_step("dyn", duration, 0.01, rtol=1e-6,
+                                                     atol=1e-9, remove=["push"]))

@@ -20,12 +20,9 @@ NaN where a node is not supported) and for non-negative tensions.
 from __future__ import annotations
 
 import math
-import os
-import re
 import signal
 import subprocess
 import sys
-import threading
 from pathlib import Path
 
 import numpy as np
@@ -37,6 +34,7 @@ import catdae.analysis
 from catdae.cli import main
 
 import scene_toml
+from processes import catdae_process, signal_when, transient_runs
 from reference import (
     irvine_catenary,
     irvine_catenary_inclined_3d,
@@ -44,7 +42,7 @@ from reference import (
     taut_string_frequencies,
 )
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, load, modal_step, static_step, transient_step
+from scene_toml import cable_scene, load, long_transient, modal_step, static_step, transient_step
 
 G = 9.81
 
@@ -767,11 +765,7 @@ def test_bad_input_through_python_m_catdae(tmp_path, command):
 # nothing lost: interruptions
 # ------------------------------------------------------------------------------------------------
 def _long_case(path: Path, duration=1000.0) -> Path:
-    span, EA, m = 10.0, 1e4, 2.0
-    path.write_text(scene(B=(span, 0, 0), L0=span / 1.1, EA=EA, mass=m, weight=0.0, elements=2,
-                          extra=node_load("push", "c.1", (0.0, 1.0, 0.0)),
-                          steps=STATIC + transient(duration, 0.01, rtol=1e-6, atol=1e-9,
-                                                   remove=["push"])))
+    path.write_text(long_transient(duration))
     return path
 
 
@@ -833,36 +827,8 @@ def test_sigint_during_a_long_transient(tmp_path):
     case = _long_case(tmp_path / "long.toml")
     out = tmp_path / "long.nc"
     out.write_bytes(b"previous results")
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
-    started = threading.Event()
-    chunks: list[bytes] = []
-    with subprocess.Popen([sys.executable, "-m", "catdae", "run", str(case), "-o", str(out),
-                           "--progress"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                          cwd=tmp_path, env=env) as proc:
-
-        def read_err():
-            while True:
-                b = proc.stderr.read1(4096)
-                if not b:
-                    return
-                chunks.append(b)
-                # the progress bar of the transient step, past t = 1 s
-                shown = re.findall(rb"dyn:.*?t=([0-9.]+)/", b"".join(chunks))
-                if shown and float(shown[-1]) > 1.0:
-                    started.set()
-
-        reader = threading.Thread(target=read_err, daemon=True)
-        reader.start()
-        try:
-            assert started.wait(180), b"".join(chunks).decode(errors="replace")
-            proc.send_signal(signal.SIGINT)
-            code = proc.wait(60)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
-        reader.join(10)
-    err = b"".join(chunks).decode(errors="replace")
+    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], tmp_path)
+    code, err = signal_when(proc, signal.SIGINT, transient_runs)
     assert code == 130, err
     assert "Traceback" not in err
     assert "catdae: interrupted by SIGINT" in err
