@@ -1,4 +1,6 @@
-"""TOML text of the one-cable scene that many tests run: cable ``c`` from node A to node B.
+"""TOML text of the test scenes: one builder for every scene a test writes (and the shared
+scenes themselves, e.g. ``long_transient``). Most are the one-cable scene, cable ``c`` from node
+A to node B.
 
 ``cable_scene`` writes, in this order and without blank lines::
 
@@ -27,6 +29,8 @@ order given, ``None`` left out) and its named forms ``cable``, ``point_mass``, `
 ``distributed_load``, ``support_motion`` and ``step``. Values: a bool as ``true``/``false``, an
 integer as such, any other number as ``num`` writes it, a string quoted (``raw(...)`` as it
 stands), a sequence as an array and a mapping as an inline table.
+
+Shared scenes: ``long_transient`` (a transient that is always interrupted before its end).
 """
 
 from __future__ import annotations
