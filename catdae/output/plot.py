@@ -38,8 +38,8 @@ def label(var: xr.DataArray, name: str | None = None) -> str:
     """'long_name [units]' from the variable's attributes (time: 's')."""
     text = name or var.attrs.get("long_name", var.name)
     units = var.attrs.get("units")
-    if units and " since " in str(units):
-        units = str(units).split(" since ")[0].replace("seconds", "s")
+    if units and " since " in str(units).lower():  # CF time: "seconds Since <epoch>"
+        units = str(units)[:str(units).lower().index(" since ")].replace("seconds", "s")
     return f"{text} [{units}]" if units else str(text)
 
 
