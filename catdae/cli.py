@@ -54,8 +54,9 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--step", nargs="+", metavar="NAME", help="steps to plot (default: all)")
     pl.add_argument("--what", nargs="+", choices=WHAT, metavar="WHAT",
                     help=f"figures: {', '.join(WHAT)} (default: all a step can make)")
-    pl.add_argument("--node", help="node of history and spectrum (default: the free node "
-                    "that moves most)")
+    pl.add_argument("--node", help="node of history and spectrum: a node name, <cable>@<p/q> "
+                    "(fraction of the cable's length, e.g. main@1/2) or <cable>@s=<m> (arc "
+                    "length); default: the free node that moves most")
     pl.add_argument("--times", nargs="+", type=float, metavar="T",
                     help="times of profile and tension, s (nearest outputs; default: 5)")
     ex = sub.add_parser("export", help="export a results file for other tools")
