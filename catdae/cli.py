@@ -144,14 +144,12 @@ def _run(args) -> int:
     except OutputError as exc:  # judged before any work: a usage error
         print(f"catdae: {exc}", file=sys.stderr)
         return 2
-    from catdae.element.elements import kernels_cached
+    from catdae.progress import announce_compiling
 
-    if not kernels_cached():
-        print("catdae: compiling the element kernels for this machine (once after install or "
-              "upgrade, about a minute)...", file=sys.stderr, flush=True)
     try:
-        tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
-                   elements=args.elements, mass_model=args.mass_model)
+        with announce_compiling():  # whenever numba compiles, the first time is announced
+            tree = run(case, output=out, progress=args.progress, rtol=args.rtol,
+                       atol=args.atol, elements=args.elements, mass_model=args.mass_model)
     except CaseError:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:

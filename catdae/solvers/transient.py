@@ -52,6 +52,15 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
 
 def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     """Integrate one transient step from ``state`` (positions, velocities, tensions)."""
+    # the progress reporter runs from the step's start: its set-up may compile the kernels
+    bar = reporter(progress, step.name, float(state.t), float(state.t) + float(step.duration))
+    try:
+        return _integrate(step, model, state, writer, bar)
+    finally:
+        bar.close()
+
+
+def _integrate(step, model: Model, state, writer, bar) -> xr.Dataset:
     wall0 = _time.perf_counter()
     prob = TransientProblem(model, step, state.X, state.h)
     t0 = float(state.t)  # one clock for the whole case: a transient continues the time
@@ -100,7 +109,6 @@ def run_transient(step, model: Model, state, writer, progress) -> xr.Dataset:
     status = "completed"
     interrupt = None
     k_done = 0
-    bar = reporter(progress, step.name, t0, t_end)
     last_write = _time.perf_counter()
 
     def dataset(n_valid):
