@@ -22,7 +22,8 @@ from catdae.interrupts import deferred
 from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
-from catdae.output import results
+from catdae.model.span import span_quantities
+from catdae.output import engineering, results
 from catdae.solvers.modal import solve_modal
 from catdae.solvers.static import solve_static
 
@@ -82,7 +83,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 model = Model(local, mesh.heated(local, temperature), absent,
                               mass_model=step.mass_model, kind=step.kind)
                 ds = _run_step(step, model, state, writer, progress)
-            ds = rotate_back(ds, rotation)
+            ds = engineering_results(step, rotate_back(ds, rotation), case, groups)
         except KeyboardInterrupt as exc:
             # keep what the finished steps (and a transient, up to the interrupt) computed;
             # the interrupt itself goes on
@@ -184,12 +185,24 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
-    return results.static_dataset(
+    ds = results.static_dataset(
         model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t),
         {"iterations": sol.iterations, "residual_norm": sol.residual_norm,
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),
     )
+    return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
+                                  engineering.rated_strengths(model.case, model.mesh.cable_names))
+
+
+def engineering_results(step: Step, ds: xr.Dataset, case: Case,
+                        groups: dict[str, xr.Dataset]) -> xr.Dataset:
+    """A transient group (in the case's axes) with its envelopes and, after a
+    ``jump_reference`` static step, the jump of each cable (catdae.output.engineering)."""
+    if step.kind != "transient":
+        return ds
+    ref = groups.get(step.jump_reference) if step.jump_reference else None
+    return engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
 
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:

@@ -214,8 +214,7 @@ def summary(tree) -> str:
                          f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
             lines.extend(_cable_lines(ds))
         elif kind == "modal":
-            f = ", ".join(f"{v:.4g}" for v in ds.frequency.values[:10])
-            lines.append(f"[{name}] modal: frequencies (Hz): {f}")
+            lines.extend(_mode_lines(name, ds))
         elif kind == "transient":
             a = ds.attrs
             lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
@@ -236,6 +235,16 @@ def summary(tree) -> str:
     return "\n".join(lines)
 
 
+def _mode_lines(name: str, ds) -> list[str]:
+    """Every mode of a modal step: its frequency and labels (plane, symmetry)."""
+    out = [f"[{name}] modal: {ds.mode.size} modes"]
+    for k, mode in enumerate(ds.mode.values):
+        labels = ", ".join(str(ds[v].values[k]) for v in ("plane", "symmetry") if v in ds)
+        out.append(f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
+                   + (f", {labels}" if labels else ""))
+    return out
+
+
 def _cable_lines(ds) -> list[str]:
     """Per cable: end tensions, horizontal tension, sag (and unstrained length)."""
     if "cable" not in ds.coords:
@@ -243,9 +252,14 @@ def _cable_lines(ds) -> list[str]:
     out = []
     for k, cab in enumerate(ds.cable.values):
         t_i, t_j = (float(v) for v in ds.cable_end_tension.values[k])
+        first = str(ds.element_node.values[ds.element_cable.values == cab][0, 0])
         line = (f"    cable {cab}: end tensions {t_i:.6g} N, {t_j:.6g} N; horizontal tension "
-                f"{float(ds.horizontal_tension.values[k]):.6g} N; sag "
-                f"{float(ds.sag.values[k]):.6g} m")
+                f"{float(ds.horizontal_tension.values[k]):.6g} N at {first} (includes the part "
+                "across the chord)")
+        if "horizontal_tension_along_chord" in ds:
+            line += (f", along the chord "
+                     f"{float(ds.horizontal_tension_along_chord.values[k]):.6g} N")
+        line += f"; sag {float(ds.sag.values[k]):.6g} m"
         if "unstrained_length" in ds:
             line += f"; L0 {float(ds.unstrained_length.values[k]):.9g} m"
         out.append(line)

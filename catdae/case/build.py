@@ -106,6 +106,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         distributed = self.distributed(top.distributed_loads, cables)
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
+        self.reference_temperature = top.reference_temperature
         steps = self.steps(top.steps)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
@@ -185,7 +186,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
-                                    float(m.thermal_expansion))
+                                    float(m.thermal_expansion), m.rated_strength)
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:

@@ -124,17 +124,54 @@ class _StepsPass:
                 extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
-                         "mass_model": v.mass_model, "inertia": v.inertia}
-            temperature = self.temperature(v.temperature_change, where)
+                         "mass_model": v.mass_model, "inertia": v.inertia,
+                         "jump_reference": self.jump_reference(v, where, out)}
+            temperature = self.step_temperature(v, where)
             if complete and temperature is not False:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
                                 add=tuple(v.add), temperature_change=temperature,
                                 **extra))
         return out
 
-    def temperature(self, raw: Any, where: tuple) -> float | FrozenMap | None | bool:
-        """A step's ``temperature_change``: K for every cable, or a table cable name -> K."""
-        where = where + ("temperature_change",)
+    def step_temperature(self, v: Any, where: tuple) -> float | FrozenMap | None | bool:
+        """A step's temperature change: its ``temperature_change``, or its ``temperature``
+        less the case's ``reference_temperature`` (a number, or per cable)."""
+        if v.temperature is None:
+            return self.temperature(v.temperature_change, where)
+        if v.temperature_change is not None:
+            self.problem(where + ("temperature",), "give either temperature or "
+                         "temperature_change, not both")
+            return False
+        if self.reference_temperature is None:
+            self.problem(where + ("temperature",), "a step's temperature needs the case's "
+                         "reference_temperature (the temperature at which the cables' lengths "
+                         "and form targets hold), e.g. reference_temperature = 15.0 at the top "
+                         "of the file; or give temperature_change instead")
+            return False
+        change = self.temperature(v.temperature, where, key="temperature")
+        ref = self.reference_temperature
+        if change is False or change is None:
+            return change
+        if isinstance(change, FrozenMap):
+            return FrozenMap({k: t - ref for k, t in change.items()})
+        return change - ref
+
+    def jump_reference(self, v: Any, where: tuple, earlier: list[Step]) -> str | None:
+        """A transient step's ``jump_reference``: the name of an earlier static step."""
+        name = v.jump_reference
+        if name is None:
+            return None
+        static = [s.name for s in earlier if s.kind == "static"]
+        if name not in static:
+            self.problem(where + ("jump_reference",), _unknown(name, "static step before this "
+                                                               "one", static))
+        return name
+
+    def temperature(self, raw: Any, where: tuple,
+                    key: str = "temperature_change") -> float | FrozenMap | None | bool:
+        """A step's ``temperature_change`` (or ``temperature``, ``key``): K for every cable,
+        or a table cable name -> K."""
+        where = where + (key,)
         if raw is None:
             return None
         if _is_number(raw):

@@ -63,7 +63,8 @@ class Material:
     ``EA`` axial stiffness, N (> 0); ``mass`` kg per metre of unstrained cable (>= 0); ``weight``
     N per metre of unstrained cable (default ``mass * gravity``); ``damping`` material damping per
     unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``);
-    ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT.
+    ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT;
+    ``rated_strength`` N (optional): results quote tensions as a percentage of it.
     """
 
     name: str
@@ -72,6 +73,7 @@ class Material:
     weight: float
     damping: float = 0.0
     thermal_expansion: float = 0.0
+    rated_strength: float | None = None  # N: the tension quoted as 100 % (optional)
 
 
 @dataclass(frozen=True)
@@ -233,6 +235,7 @@ class Step:
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
+    jump_reference: str | None = None  # transient: an earlier static step (jump_height)
 
     def __post_init__(self):
         if isinstance(self.temperature_change, Mapping):

@@ -29,6 +29,7 @@ class _Top(BaseModel):
     title: str = ""
     source: str = ""
     gravity: Any = 9.81  # a number (along -z) or [gx, gy, gz]: checked by the builder
+    reference_temperature: float | None = None  # °C (or K): where lengths hold; steps' temperature
     materials: dict[str, TomlTable] = {}
     nodes: dict[str, Any] = {}
     supports: dict[str, Any] = {}
@@ -47,6 +48,7 @@ class _Material(BaseModel):
     weight: NonNeg | None = None
     damping: NonNeg = 0.0
     thermal_expansion: float = 0.0
+    rated_strength: Pos | None = None  # N, optional
 
 
 class _Cable(BaseModel):
@@ -106,6 +108,7 @@ class _StaticStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     load_steps: Annotated[int, Field(ge=1)] = 1
 
@@ -116,6 +119,7 @@ class _ModalStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
@@ -127,6 +131,7 @@ class _TransientStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     duration: Time
     output_interval: Time
@@ -137,6 +142,7 @@ class _TransientStep(BaseModel):
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
+    jump_reference: Name | None = None  # an earlier static step: jump_height results
 
 
 class _Form(BaseModel):
