@@ -83,7 +83,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 model = Model(local, mesh.heated(local, temperature), absent,
                               mass_model=step.mass_model, kind=step.kind)
                 ds = _run_step(step, model, state, writer, progress)
-            ds = engineering_results(step, rotate_back(ds, rotation), case, groups)
+            ds = engineering_results(step, rotate_back(ds, rotation), case, groups,
+                                     temperature)
         except KeyboardInterrupt as exc:
             # keep what the finished steps (and a transient, up to the interrupt) computed;
             # the interrupt itself goes on
@@ -196,12 +197,20 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
 
 
 def engineering_results(step: Step, ds: xr.Dataset, case: Case,
-                        groups: dict[str, xr.Dataset]) -> xr.Dataset:
-    """A transient group (in the case's axes) with its envelopes and, after a
-    ``jump_reference`` static step, the jump of each cable (catdae.output.engineering)."""
+                        groups: dict[str, xr.Dataset], temperature) -> xr.Dataset:
+    """A step's group (in the case's axes) with, for a uniform temperature change, the attrs
+    ``temperature_change`` (K) and, with the case's ``reference_temperature``, ``temperature``;
+    a transient group also with its envelopes and, after a ``jump_reference`` static step,
+    the jump of each cable (catdae.output.engineering)."""
+    if not isinstance(temperature, dict) and not hasattr(temperature, "items"):
+        ds = ds.assign_attrs(temperature_change=float(temperature))
+        if case.reference_temperature is not None:
+            ds = ds.assign_attrs(temperature=case.reference_temperature + float(temperature))
     if step.kind != "transient":
         return ds
     ref = groups.get(step.jump_reference) if step.jump_reference else None
+    if ref is not None:
+        ds = ds.assign_attrs(jump_reference=step.jump_reference)
     return engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
 
 

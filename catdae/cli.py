@@ -20,7 +20,7 @@ from catdae._version import __version__
 from catdae.errors import CaseError, CatdaeError, OutputError
 from catdae.interrupts import signals_as_interrupts
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.output.plot.WHAT
+WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans")  # catdae.output.plot.WHAT
 
 DEFAULT_CASE = "example1_free_vibration.toml"
 
@@ -210,8 +210,10 @@ def summary(tree) -> str:
         ds = node.to_dataset()
         kind = ds.attrs.get("kind", "")
         if kind == "static":
-            lines.append(f"[{name}] static: {ds.attrs.get('iterations')} Newton iterations, "
-                         f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
+            hot = (f" at {ds.attrs['temperature']:.6g} deg" if "temperature" in ds.attrs
+                   else "")
+            lines.append(f"[{name}] static{hot}: {ds.attrs.get('iterations')} Newton "
+                         f"iterations, residual {ds.attrs.get('residual_norm', 0):.2e} N")
             lines.extend(_cable_lines(ds))
         elif kind == "modal":
             lines.extend(_mode_lines(name, ds))
@@ -230,6 +232,7 @@ def summary(tree) -> str:
             lines.append(f"    largest motion of a free node at {node}: "
                          f"{float(mag.sel(node=node).max()):.4g} m; "
                          f"max tension {float(ds.tension.max()):.6g} N")
+            lines.extend(_jump_lines(ds))
             if a.get("note"):
                 lines.append(f"    note: {a['note']}")
     return "\n".join(lines)
@@ -243,6 +246,39 @@ def _mode_lines(name: str, ds) -> list[str]:
         out.append(f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
                    + (f", {labels}" if labels else ""))
     return out
+
+
+def _jump_lines(ds) -> list[str]:
+    """Per cable of a transient: its largest rise above the jump_reference step, the largest
+    tension as a percentage of the rated strength (catdae.output.engineering)."""
+    out = []
+    for k, cab in enumerate(ds.cable.values if "cable" in ds.coords else ()):
+        parts = []
+        if "jump_height" in ds:
+            parts.append(f"jump {float(ds.jump_height.values[k]):.6g} m above step "
+                         f"'{ds.attrs.get('jump_reference', '')}' at t = "
+                         f"{float(ds.jump_time.values[k]):.6g} s, s = "
+                         f"{float(ds.jump_s.values[k]):.6g} m")
+        if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
+            parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % "
+                         "of rated strength")
+        if parts:
+            out.append(f"    cable {cab}: " + "; ".join(parts))
+    return out
+
+
+def _span_lines(ds, k: int) -> list[str]:
+    """The span quantities of cable k (catdae.output.engineering), when the group has them."""
+    if "sag_midspan" not in ds:
+        return []
+    parts = [f"sag at midspan {float(ds.sag_midspan.values[k]):.6g} m",
+             f"at the lowest point {float(ds.sag_lowest_point.values[k]):.6g} m below the lower "
+             "end",
+             f"swing angle {float(ds.swing_angle.values[k]):.4g} deg"]
+    if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
+        parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % of "
+                     "rated strength")
+    return ["      " + "; ".join(parts)]
 
 
 def _cable_lines(ds) -> list[str]:
@@ -263,6 +299,7 @@ def _cable_lines(ds) -> list[str]:
         if "unstrained_length" in ds:
             line += f"; L0 {float(ds.unstrained_length.values[k]):.9g} m"
         out.append(line)
+        out.extend(_span_lines(ds, k))
     return out
 
 

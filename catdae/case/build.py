@@ -121,6 +121,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
             steps=tuple(steps), path=self.path, text=text, name=name,
+            reference_temperature=top.reference_temperature,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:

@@ -266,6 +266,7 @@ class Case:
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
     steps: tuple[Step, ...] = ()
+    reference_temperature: float | None = None  # °C: where lengths hold (steps' temperature)
     path: str | None = None
     text: str = field(default="", repr=False)
     name: str = "case"

@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 from catdae._xr import xr
 from catdae.errors import CatdaeError
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes")
+WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans")
 
 
 class PlotError(CatdaeError):
@@ -324,5 +324,12 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
             fig = _figure(w, ds, node, times)
             path = folder / f"{name}-{w}.png"
             fig.savefig(path, dpi=120)
+            written.append(path)
+    if "spans" in wanted:  # one figure across the static steps (catdae.output.plot_spans)
+        from catdae.output.plot_spans import spans, static_groups
+
+        if len(static_groups(tree, steps)) >= 2:
+            path = folder / "spans.png"
+            spans(tree, steps).savefig(path, dpi=120)
             written.append(path)
     return written
