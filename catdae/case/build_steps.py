@@ -172,13 +172,16 @@ class _StepsPass:
         """A step's ``temperature_change`` (or ``temperature``, ``key``): K for every cable,
         or a table cable name -> K."""
         where = where + (key,)
+        what = ("a temperature change in K" if key == "temperature_change"
+                else "a temperature (the units of reference_temperature)")
         if raw is None:
             return None
         if _is_number(raw):
             return float(raw)
         if not isinstance(raw, dict):
-            self.problem(where, "expected a temperature change in K (a number, for every "
-                         f"cable) or a table cable name -> K, found {_found(raw)}")
+            self.problem(where, f"expected {what} (a number, for every cable) or a table "
+                         f"cable name -> {'K' if key == 'temperature_change' else 'temperature'}, found "
+                         f"{_found(raw)}")
             return False
         ok = True
         for key, value in raw.items():
@@ -186,8 +189,8 @@ class _StepsPass:
                 self.problem(where + (key,), _unknown(key, "cable", sorted(self.cable_names)))
                 ok = False
             elif not _is_number(value):
-                self.problem(where + (key,), f"expected a temperature change in K (a finite "
-                             f"number), found {_found(value)}")
+                self.problem(where + (key,), f"expected {what} (a finite number), found "
+                             f"{_found(value)}")
                 ok = False
         return FrozenMap({k: float(v) for k, v in raw.items()}) if ok else False
 
