@@ -172,7 +172,8 @@ class _StepsPass:
         """A step's ``temperature_change`` (or ``temperature``, ``key``): K for every cable,
         or a table cable name -> K."""
         where = where + (key,)
-        what = ("a temperature change in K" if key == "temperature_change"
+        change = key == "temperature_change"
+        what = ("a temperature change in K" if change
                 else "a temperature (the units of reference_temperature)")
         if raw is None:
             return None
@@ -180,8 +181,7 @@ class _StepsPass:
             return float(raw)
         if not isinstance(raw, dict):
             self.problem(where, f"expected {what} (a number, for every cable) or a table "
-                         f"cable name -> {'K' if key == 'temperature_change' else 'temperature'}, found "
-                         f"{_found(raw)}")
+                         f"cable name -> {'K' if change else 'temperature'}, found {_found(raw)}")
             return False
         ok = True
         for key, value in raw.items():
