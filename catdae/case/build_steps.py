@@ -8,6 +8,8 @@ import re
 import unicodedata
 from typing import Any
 
+import numpy as np
+
 from catdae.case.messages import _fmt_path, _found, _is_number, _short, _unknown
 from catdae.case.model import (
     AXES,
@@ -21,6 +23,7 @@ from catdae.case.schema import (
     _STEP_MODELS,
     _SupportMotion,
 )
+from catdae.case.timefunc_compose import Scaled
 
 
 class _StepsPass:
@@ -47,11 +50,17 @@ class _StepsPass:
                 ok = False
             else:
                 seen[v.node] = i
+            fixed = supports.get(v.node)
+            if "direction" in item or "value" in item:
+                funcs = self.directed_motion(v, item, where, fixed)
+                if funcs is not None and fixed is not None and ok:
+                    out.append(SupportMotion(v.node, **funcs))
+                continue
             if not any(axis in item for axis in AXES):
-                self.problem(where, "a support motion needs at least one of x, y, z")
+                self.problem(where, "a support motion needs at least one of x, y, z (or "
+                             "direction and value)")
                 ok = False
             funcs = {}
-            fixed = supports.get(v.node)
             for axis in AXES:
                 spec = getattr(v, axis)
                 if spec is None:
@@ -66,6 +75,38 @@ class _StepsPass:
             if ok and fixed is not None:
                 out.append(SupportMotion(v.node, **funcs))
         return out
+
+    def directed_motion(self, v: Any, item: dict, where: tuple, fixed) -> dict | None:
+        """``direction = [dx, dy, dz]`` with ``value = <time function>``: the displacement
+        value(t) along the unit vector of the direction, as x, y, z motions of the node."""
+        if any(axis in item for axis in AXES):
+            self.problem(where, "give either direction and value, or x, y, z, not both")
+            return None
+        if v.direction is None or v.value is None:
+            missing = "direction" if v.direction is None else "value"
+            if missing not in item:  # present but malformed: already reported
+                self.problem(where + (missing,), "missing: a motion along a direction needs "
+                             "direction = [dx, dy, dz] and value = <time function> (m)")
+            return None
+        d = np.asarray(v.direction, float)
+        norm = float(np.linalg.norm(d))
+        if not norm > 0.0:
+            self.problem(where + ("direction",), "expected a direction of non-zero length, "
+                         "found [0, 0, 0]")
+            return None
+        moved = [a for a, c in zip(AXES, d, strict=True) if c != 0.0]
+        if fixed is not None:
+            free = [a for a in moved if a not in fixed]
+            if free:
+                self.problem(where + ("direction",), f"the direction has a component along "
+                             f"axis {free[0]!r} of node {v.node!r}, which is not fixed (fixed "
+                             f"axes: {list(fixed)}); only fixed axes can be moved")
+                return None
+        tf = self.time_function(v.value, where + ("value",), motion=True)
+        if tf is None:
+            return None
+        return {a: Scaled(tf, float(c / norm)) for a, c in zip(AXES, d, strict=True)
+                if c != 0.0}
 
     def steps(self, raw: list[dict]) -> list[Step]:
         out = []

@@ -100,6 +100,8 @@ class _SupportMotion(BaseModel):
     x: TomlTable | None = None
     y: TomlTable | None = None
     z: TomlTable | None = None
+    direction: Vec3 | None = None  # with value: a motion along this direction
+    value: TomlTable | None = None  # the displacement along ``direction`` (m)
 
 
 class _StaticStep(BaseModel):
@@ -216,9 +218,26 @@ class _TableTF(BaseModel):
     quantity: Literal["displacement", "velocity", "acceleration"] = "displacement"
 
 
+class _ProductTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["product"]
+    factors: list[TomlTable]  # time functions, multiplied (at least 2: the builder)
+
+
+class _TrapezoidTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["trapezoid"]
+    rise: Time
+    hold: NonNeg = 0.0
+    fall: Time
+    start: float = 0.0
+    amplitude: float = 1.0
+    smooth: bool = False
+
+
 _TIME_MODELS: dict[str, type[BaseModel]] = {
     "constant": _ConstantTF, "ramp": _RampTF, "sine": _SineTF, "cosine": _SineTF,
-    "table": _TableTF,
+    "table": _TableTF, "product": _ProductTF, "trapezoid": _TrapezoidTF,
 }
 
 _VEC3 = TypeAdapter(Vec3, config=ConfigDict(strict=True, allow_inf_nan=False))
