@@ -262,6 +262,9 @@ def _jump_lines(ds) -> list[str]:
         if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
             parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % "
                          "of rated strength")
+        if "clearance_time" in ds:
+            parts.append(f"least clearance {float(ds.clearance.values[k]):.6g} m at t = "
+                         f"{float(ds.clearance_time.values[k]):.6g} s")
         if parts:
             out.append(f"    cable {cab}: " + "; ".join(parts))
     return out
@@ -278,6 +281,9 @@ def _span_lines(ds, k: int) -> list[str]:
     if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
         parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % of "
                      "rated strength")
+    if "clearance" in ds:
+        parts.append(f"clearance above the ground {float(ds.clearance.values[k]):.6g} m at "
+                     f"s = {float(ds.clearance_s.values[k]):.6g} m")
     return ["      " + "; ".join(parts)]
 
 

@@ -20,6 +20,7 @@ from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # 
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.frame import gravity_rotation, local_axes
+from catdae.case.ground import _GroundPass
 from catdae.case.limits import size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from catdae.case.model import (
@@ -38,7 +39,7 @@ from catdae.case.schema import (
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass):
+class _Builder(_CablesPass, _StepsPass, _TimePass, _GroundPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -107,6 +108,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         self.reference_temperature = top.reference_temperature
+        ground = self.ground(top.ground, self.gravity_direction)
         steps = self.steps(top.steps)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
@@ -121,7 +123,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
             steps=tuple(steps), path=self.path, text=text, name=name,
-            reference_temperature=top.reference_temperature,
+            reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:

@@ -267,6 +267,7 @@ class Case:
     support_motions: tuple[SupportMotion, ...] = ()
     steps: tuple[Step, ...] = ()
     reference_temperature: float | None = None  # °C: where lengths hold (steps' temperature)
+    ground: Any = None  # catdae.case.ground.Ground: clearance results
     path: str | None = None
     text: str = field(default="", repr=False)
     name: str = "case"

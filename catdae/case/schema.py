@@ -39,6 +39,7 @@ class _Top(BaseModel):
     distributed_loads: list[TomlTable] = []
     support_motions: list[TomlTable] = []
     steps: list[TomlTable] = []
+    ground: TomlTable | None = None  # catdae.case.ground
 
 
 class _Material(BaseModel):

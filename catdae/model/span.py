@@ -50,6 +50,40 @@ def span_quantities(model, X: np.ndarray, state) -> dict[str, np.ndarray]:
         for key, value in _one_cable(model, X, state, els, s, pts[els]).items():
             out[key][ci] = value
         out["tension_max"][ci] = float(tens[els].max())
+    ground = getattr(model.case, "ground", None)
+    if ground is not None:
+        out.update(clearances(model, X, state, ground, s, pts))
+    return out
+
+
+def clearances(model, X, state, ground, s, pts) -> dict[str, np.ndarray]:
+    """Per cable the least height of the cable above ``ground`` (a catdae.case.ground.Ground:
+    heights are z, abscissae x of the gravity frame, which is the case's frame whenever a
+    profile is allowed), ``clearance`` m, and where, ``clearance_s`` m (unstrained arc length
+    at the reference temperature): the lowest sample refined on its element's exact curve."""
+    from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
+
+    mesh = model.mesh
+    nc = len(mesh.cable_names)
+    out = {"clearance": np.full(nc, np.nan), "clearance_s": np.full(nc, np.nan)}
+    gap = pts[..., 2] - ground.height(pts[..., 0])  # (n_elem, N_SAMPLE) m
+    n_s = s.shape[1]
+    for ci in range(nc):
+        els = np.flatnonzero(mesh.cable_of_element == ci)
+        m, j = np.unravel_index(int(np.argmin(gap[els])), (els.size, n_s))
+        e = int(els[m])
+        xi = X[mesh.conn[e, 0]]
+
+        def above(v, e=e, xi=xi):
+            p = xi + _point(model, state, e, v)
+            return float(p[2] - ground.height(p[0]))
+
+        best = minimize_scalar(above, bounds=(s[e, max(j - 1, 0)], s[e, min(j + 1, n_s - 1)]),
+                               method="bounded", options={"xatol": 1e-11 * mesh.L0[e]})
+        s_c, g = ((float(best.x), float(best.fun)) if best.fun < gap[e, j]
+                  else (float(s[e, j]), float(gap[e, j])))
+        out["clearance"][ci] = g
+        out["clearance_s"][ci] = (mesh.s_start[e] + s_c) / mesh.thermal[e]
     return out
 
 

@@ -32,6 +32,9 @@ _SPAN = {  # name: (units, long_name)
 }
 
 
+_CLEARANCE = "least height of the cable above the case's [ground] (negative: below it)"
+
+
 def _cable_var(values, units: str, long_name: str) -> xr.Variable:
     return xr.Variable("cable", np.asarray(values, float),
                        {"units": units, "long_name": long_name})
@@ -58,6 +61,10 @@ def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
         data["tension_percent_rated"] = _cable_var(
             100.0 * quantities["tension_max"] / rated, "percent",
             "largest tension along the cable as a percentage of the material's rated_strength")
+    if "clearance" in quantities:
+        data["clearance"] = _cable_var(quantities["clearance"], "m", _CLEARANCE)
+        data["clearance_s"] = _cable_var(quantities["clearance_s"], "m",
+                                         "unstrained arc length where the clearance is least")
     return ds.assign(data)
 
 
@@ -109,7 +116,37 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
                                              {"long_name": "cable name"})).assign(data)
     if reference is not None:
         out = out.assign(jump(ds, reference, cables, up))
+    if getattr(case, "ground", None) is not None:
+        out = out.assign(clearance_over_time(ds, case.ground, cables, up))
     return out
+
+
+def clearance_over_time(ds: xr.Dataset, ground, cables: list[str],
+                        up: np.ndarray | None = None) -> dict[str, xr.Variable]:
+    """Per cable the least height of its nodes above the ground over the output times, when
+    and where (at the nodes: between nodes the exact curve is not stored in a transient)."""
+    up = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, float)
+    x = ds.position.values  # (time, node, 3) m
+    gap = x @ up - ground.height(x[..., 0])  # (time, node) m
+    least, when, where = [], [], []
+    for c in cables:
+        sel = ds.element_cable.values == c
+        nodes = np.unique(ds.element_node.values[sel])
+        k = np.flatnonzero(np.isin(ds.node.values.astype(str), nodes.astype(str)))
+        g = gap[:, k]
+        k_t, k_n = np.unravel_index(int(np.argmin(g)), g.shape)
+        least.append(float(g[k_t, k_n]))
+        when.append(float(ds.time.values[k_t]))
+        node = str(ds.node.values[k[k_n]])
+        at = (ds.element_node.values == node) & sel[:, None]
+        where.append(float(ds.element_s.values[at][0]))
+    return {
+        "clearance": _cable_var(least, "m", _CLEARANCE + ", at the nodes, over the output "
+                                "times"),
+        "clearance_time": _cable_var(when, "s", "time of the least clearance"),
+        "clearance_s": _cable_var(where, "m", "unstrained arc length of the node of least "
+                                  "clearance"),
+    }
 
 
 def jump(ds: xr.Dataset, reference: xr.Dataset, cables: list[str],

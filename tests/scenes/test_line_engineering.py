@@ -76,6 +76,7 @@ def test_drake_sag_temperature_table(tmp_path):
         end = math.hypot(H, 0.5 * w * L0)  # the support carries half the weight
         assert float(got.tension_percent_rated) == pytest.approx(100 * end / 140.1e3, rel=1e-9)
         assert float(got.swing_angle) == pytest.approx(0.0, abs=1e-9)
+        assert float(got.clearance) == pytest.approx(30.0 - sag, rel=1e-9)  # ground at 0
         table.append((T, sag))
     table.sort()
     y = drawn["span|sag_midspan"].get_ydata()
