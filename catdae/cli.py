@@ -20,7 +20,8 @@ from catdae._version import __version__
 from catdae.errors import CaseError, CatdaeError, OutputError
 from catdae.interrupts import signals_as_interrupts
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans")  # catdae.output.plot.WHAT
+# catdae.output.plot.WHAT
+WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
 DEFAULT_CASE = "example1_free_vibration.toml"
 

@@ -27,8 +27,9 @@ from matplotlib.figure import Figure
 
 from catdae._xr import xr
 from catdae.errors import CatdaeError
+from catdae.output.plot_envelopes import mark_peaks, reactions
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans")
+WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
 
 class PlotError(CatdaeError):
@@ -188,6 +189,7 @@ def history(data, node: str | None = None) -> Figure:
     fig, axes = _subplots(3, 1, figsize=(8, 7), sharex=True)
     for ax, a in zip(axes, ds.axis.values, strict=True):
         ax.plot(ds.time.values, d.sel(axis=a).values, gid=f"{node}|{a}")
+        mark_peaks(ax, ds, "displacement", node, str(a))  # the envelope, when stored
         ax.set_ylabel(label(ds.displacement, f"{a}"))
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel(label(ds.time, "time"))
@@ -297,6 +299,8 @@ def _figure(what: str, ds: xr.Dataset, node, times) -> Figure:
         return history(ds, node) if what == "history" else spectrum(ds, node)
     if what in ("profile", "tension"):
         return profile(ds, times) if what == "profile" else tension(ds, times)
+    if what == "reactions":
+        return reactions(ds)
     return modes(ds)
 
 
@@ -317,7 +321,8 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
         ds = tree[name].to_dataset()
         kind = ds.attrs.get("kind")
         can = {"static": ("profile", "tension"), "modal": ("modes",),
-               "transient": ("profile", "history", "spectrum", "tension")}.get(kind, ())
+               "transient": ("profile", "history", "spectrum", "tension", "reactions")
+               }.get(kind, ())
         for w in wanted:
             if w not in can:
                 continue

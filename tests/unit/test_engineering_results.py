@@ -135,3 +135,28 @@ def test_rated_strength_must_be_positive(tmp_path, capsys):
                          steps='[[steps]]\nkind = "static"\n'))
     assert main(["check", str(path)]) == 2
     assert "materials.m.rated_strength" in capsys.readouterr().err
+
+
+def test_figures_show_the_envelopes(kicked, tmp_path):
+    from catdae.output import plot
+    from catdae.output.plot_envelopes import reactions
+
+    ds = kicked["kicked"].ds
+    fig = plot.history(ds, "c@1/2")
+    marks = {ln.get_gid(): ln for ax in fig.axes for ln in ax.get_lines()}
+    for a in ("x", "y", "z"):
+        for how in ("max", "min"):
+            ln = marks[f"c.3|{a}|{how}"]
+            assert ln.get_xdata()[0] == float(ds[f"displacement_{how}_time"].sel(node="c.3",
+                                                                                 axis=a))
+            assert ln.get_ydata()[0] == float(ds[f"displacement_{how}"].sel(node="c.3", axis=a))
+    fig = reactions(ds)
+    gids = {ln.get_gid() for ax in fig.axes for ln in ax.get_lines()}
+    assert {"A|y", "B|y", "A|y|max", "B|z|min"} <= gids
+    assert not any(g.startswith("c.") for g in gids)  # free nodes have no reaction
+    path = tmp_path / "r.nc"
+    from catdae.output.results import write_tree
+
+    write_tree(kicked, path)
+    assert main(["plot", str(path), "-o", str(tmp_path / "p"), "--what", "reactions"]) == 0
+    assert (tmp_path / "p" / "kicked-reactions.png").is_file()
