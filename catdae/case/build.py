@@ -17,8 +17,10 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_fluid import _FluidPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
+from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
 from catdae.case.ground import _GroundPass
 from catdae.case.limits import size_problems
@@ -40,7 +42,7 @@ from catdae.case.schema import (
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass, _GroundPass):
+class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _GroundPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -111,6 +113,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _GroundPass):
         self.reference_temperature = top.reference_temperature
         ground = self.ground(top.ground, self.gravity_direction)
         steps = self.steps(top.steps)
+        water, air = self.water(top.water), self.air(top.air)
+        self.fluid_lines(top.materials, water, air)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -123,7 +127,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _GroundPass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), path=self.path, text=text, name=name,
+            steps=tuple(steps), water=water, air=air, path=self.path, text=text, name=name,
             reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
@@ -190,7 +194,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _GroundPass):
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
-                                    float(m.thermal_expansion), m.rated_strength)
+                                    float(m.thermal_expansion), **line_fluid(m),
+                                    rated_strength=m.rated_strength)
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:

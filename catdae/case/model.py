@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 from pydantic import ValidationError
 
+from catdae.case.fluid import Air, Water
 from catdae.case.limits import size_problems
 from catdae.case.messages import _message
 from catdae.case.names import mesh_node, split_mesh_node
@@ -67,7 +68,10 @@ class Material:
     ``EA`` axial stiffness, N (> 0); ``mass`` kg per metre of unstrained cable (>= 0); ``weight``
     N per metre of unstrained cable (default ``mass * gravity``); ``damping`` material damping per
     unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``);
-    ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT;
+    ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT.
+    In water or air (docs/theory.md §13): ``diameter`` d, m (0: the line feels no fluid), the
+    drag coefficients ``drag_normal`` and ``drag_axial`` and the added-mass coefficients
+    ``added_mass_normal`` and ``added_mass_axial`` (MoorDyn's Cd, CdAx, Ca, CaAx).
     ``rated_strength`` N (optional): results quote tensions as a percentage of it.
     """
 
@@ -77,6 +81,11 @@ class Material:
     weight: float
     damping: float = 0.0
     thermal_expansion: float = 0.0
+    diameter: float = 0.0
+    drag_normal: float = 0.0
+    drag_axial: float = 0.0
+    added_mass_normal: float = 0.0
+    added_mass_axial: float = 0.0
     rated_strength: float | None = None  # N: the tension quoted as 100 % (optional)
 
 
@@ -252,7 +261,8 @@ class Case:
 
     ``nodes`` maps names to ``(x, y, z)`` in m; ``supports`` maps node names to their fixed axes
     (a subset of ``AXES`` in x, y, z order); ``gravity`` in m/s² acts along the unit vector
-    ``gravity_direction`` (default -z). ``path`` is the
+    ``gravity_direction`` (default -z); ``water`` and ``air`` the fluids around the cables
+    (``None``: none). ``path`` is the
     case file (``None`` for text), ``text`` its TOML text, ``name`` its stem. Constructing a Case
     directly skips validation; mappings and sequences are frozen either way.
     """
@@ -272,6 +282,8 @@ class Case:
     steps: tuple[Step, ...] = ()
     reference_temperature: float | None = None  # °C: where lengths hold (steps' temperature)
     ground: Any = None  # catdae.case.ground.Ground: clearance results
+    water: Water | None = None  # docs/case-format.md, "Water and air"
+    air: Air | None = None
     path: str | None = None
     text: str = field(default="", repr=False)
     name: str = "case"

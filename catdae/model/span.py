@@ -1,4 +1,4 @@
-"""What a line engineer reads off a span, on the exact curve of its elements (docs/theory.md §13).
+"""What a line engineer reads off a span, on the exact curve of its elements (docs/theory.md §14).
 
 Per cable, in the gravity frame (z up), from the node positions ``X`` and the element states:
 the horizontal tension along the chord, the sag at midspan and at the lowest point, the swing

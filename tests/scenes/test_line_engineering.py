@@ -1,5 +1,5 @@
 """The line engineer's three scenes of issue 23, from ``catdae run`` and ``catdae plot`` alone
-(the bundled cases), each against its closed form or hand calculation (docs/theory.md §13):
+(the bundled cases), each against its closed form or hand calculation (docs/theory.md §14):
 
 - the Drake sag-temperature table (cases/drake_sag_temperature.toml): the elastic catenary of a
   level span with a thermal strain (Irvine 1981 §2.2), solved here by brentq;
