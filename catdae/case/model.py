@@ -72,6 +72,7 @@ class Material:
     In water or air (docs/theory.md §13): ``diameter`` d, m (0: the line feels no fluid), the
     drag coefficients ``drag_normal`` and ``drag_axial`` and the added-mass coefficients
     ``added_mass_normal`` and ``added_mass_axial`` (MoorDyn's Cd, CdAx, Ca, CaAx).
+    ``rated_strength`` N (optional): results quote tensions as a percentage of it.
     """
 
     name: str
@@ -85,6 +86,7 @@ class Material:
     drag_axial: float = 0.0
     added_mass_normal: float = 0.0
     added_mass_axial: float = 0.0
+    rated_strength: float | None = None  # N: the tension quoted as 100 % (optional)
 
 
 @dataclass(frozen=True)
@@ -218,7 +220,7 @@ class Damping:
 class AxialDamping:
     """Strain-rate (Kelvin-Voigt) damping of a transient step: a share ``ratio`` of critical at
     ``frequency`` (Hz), or at each element's highest axial frequency (``"element"``); it acts
-    on the axial strain rate only (docs/theory.md §14)."""
+    on the axial strain rate only (docs/theory.md §15)."""
 
     ratio: float
     frequency: float | Literal["element"] = "element"
@@ -257,6 +259,7 @@ class Step:
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
+    jump_reference: str | None = None  # transient: an earlier static step (jump_height)
     axial_damping: AxialDamping | None = None
 
     def __post_init__(self):
@@ -289,6 +292,8 @@ class Case:
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
     steps: tuple[Step, ...] = ()
+    reference_temperature: float | None = None  # °C: where lengths hold (steps' temperature)
+    ground: Any = None  # catdae.case.ground.Ground: clearance results
     water: Water | None = None  # docs/case-format.md, "Water and air"
     air: Air | None = None
     path: str | None = None

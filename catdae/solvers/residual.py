@@ -103,7 +103,7 @@ class TransientProblem(ConsistentStart):
         self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
         self._fast_setup()
-        self.axial = AxialDamping.of(model, step, self.fidx)  # docs/theory.md §14, or None
+        self.axial = AxialDamping.of(model, step, self.fidx)  # docs/theory.md §15, or None
 
     def _fast_setup(self) -> None:
         """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
