@@ -23,7 +23,9 @@ from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
 from catdae.output import results
-from catdae.solvers.modal import solve_modal
+from catdae.output.connectors import with_connector_forces, with_damped_modes
+from catdae.solvers.damped_modes import solve_damped
+from catdae.solvers.modal import classify, solve_modal
 from catdae.solvers.static import solve_static
 
 
@@ -184,12 +186,13 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
-    return results.static_dataset(
-        model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t),
+    ds = results.static_dataset(
+        model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t, sol.X),
         {"iterations": sol.iterations, "residual_norm": sol.residual_norm,
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),
     )
+    return with_connector_forces(ds, model.connectors, sol.X)
 
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
@@ -199,11 +202,18 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
         raise ConvergenceError(f"modal step '{step.name}': an element cannot be solved in the "
                                "current configuration")
     sol = solve_modal(model, state.X, est, step.modes)
-    return results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
-                                 {"solver": sol.solver, "mass_model": model.mass_model,
-                                  "mass_model_setting": model.mass_model_setting,
-                                  "mass_model_choice": model.mass_model_choice,
-                                  "status": "completed"})
+    ds = results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
+                               {"solver": sol.solver, "mass_model": model.mass_model,
+                                "mass_model_setting": model.mass_model_setting,
+                                "mass_model_choice": model.mass_model_choice,
+                                "status": "completed"})
+    damped = solve_damped(model, state.X, est, step.modes, step.damping)
+    if damped is not None:  # docs/theory.md §14
+        modes, shapes = damped
+        plane, symmetry = classify(model, state.X, shapes.real)
+        ds = with_damped_modes(ds, modes, shapes, plane, symmetry).assign_attrs(
+            damped_solver=modes.solver)
+    return ds
 
 
 def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:

@@ -17,6 +17,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_connectors import _ConnectorsPass, connector_ends
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.frame import gravity_rotation, local_axes
@@ -38,7 +39,7 @@ from catdae.case.schema import (
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass):
+class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _TimePass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -94,6 +95,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         supports = self.supports(top.supports, nodes)
         self.gravity_supports(supports)
         cables = self.cables(top.cables, materials, nodes)
+        self.cable_ends |= connector_ends(top)  # what a connector holds is held
         if not top.cables and "cables" not in bad:
             self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "
                          '(name, ends = ["A", "B"], material, length)')
@@ -104,6 +106,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         point_masses = self.located(top.point_masses, "point_masses", _PointMass, cables, nodes)
         loads = self.located(top.loads, "loads", _Load, cables, nodes)
         distributed = self.distributed(top.distributed_loads, cables)
+        connectors = self.connectors(top, cables, nodes)
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         steps = self.steps(top.steps)
@@ -119,7 +122,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), path=self.path, text=text, name=name,
+            **connectors, steps=tuple(steps), path=self.path, text=text, name=name,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -132,7 +135,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         found: list[tuple[tuple, str]] = [(("title",), top.title), (("source",), top.source)]
         found += [(("materials", k), k) for k in top.materials]
         found += [(("nodes", k), k) for k in top.nodes]
-        for section in ("cables", "point_masses", "loads", "distributed_loads"):  # steps:
+        for section in ("cables", "point_masses", "loads", "distributed_loads", "springs",
+                        "dampers", "bars"):  # steps:
             # their names are held to the stricter rule of group names (steps())
             found += [((section, i, "name"), item["name"]) for i, item in
                       enumerate(getattr(top, section)) if isinstance(item.get("name"), str)]

@@ -110,7 +110,8 @@ class _StepsPass:
             if kind == "static":
                 extra = {"load_steps": v.load_steps}
             elif kind == "modal":
-                extra = {"modes": v.modes, "mass_model": v.mass_model}
+                extra = {"modes": v.modes, "mass_model": v.mass_model,
+                         "damping": None if v.damping is None else self.damping(v.damping, where)}
             else:
                 if v.output_interval > v.duration:
                     self.problem(where + ("output_interval",), "expected at most the step "

@@ -12,6 +12,7 @@ from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
+from catdae.case.build_connectors import Bar, Damper, Spring
 from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from catdae.case.messages import _found, _is_number
 from catdae.case.timefunc import TimeFunction
@@ -262,6 +263,9 @@ class Case:
     loads: tuple[Load, ...] = ()
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
+    springs: tuple[Spring, ...] = ()
+    dampers: tuple[Damper, ...] = ()
+    bars: tuple[Bar, ...] = ()
     steps: tuple[Step, ...] = ()
     path: str | None = None
     text: str = field(default="", repr=False)
@@ -271,7 +275,7 @@ class Case:
         for key in ("materials", "nodes", "supports"):
             object.__setattr__(self, key, FrozenMap(getattr(self, key)))
         for key in ("cables", "point_masses", "loads", "distributed_loads", "support_motions",
-                    "steps"):
+                    "springs", "dampers", "bars", "steps"):
             object.__setattr__(self, key, tuple(getattr(self, key)))
 
     def cable(self, name: str) -> Cable:

@@ -37,6 +37,9 @@ class _Top(BaseModel):
     loads: list[TomlTable] = []
     distributed_loads: list[TomlTable] = []
     support_motions: list[TomlTable] = []
+    springs: list[TomlTable] = []  # connectors: validated by build_connectors
+    dampers: list[TomlTable] = []
+    bars: list[TomlTable] = []
     steps: list[TomlTable] = []
 
 
@@ -119,6 +122,7 @@ class _ModalStep(BaseModel):
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
+    damping: TomlTable | None = None
 
 
 class _TransientStep(BaseModel):

@@ -16,6 +16,7 @@ import scipy.sparse as sp
 from catdae.case import Case
 from catdae.case.timefunc import TimeFunction
 from catdae.element.elements import Elements, ElementState, PointLoads
+from catdae.model.connectors import build_connectors, extend, with_connectors
 from catdae.model.loading import (  # noqa: F401  (re-exported)
     Loading,
     build_loading,
@@ -60,9 +61,9 @@ class Pattern:
                  scale: float = 1.0) -> np.ndarray:
         """CSR data array (nnz,) of scale * Σ blocks + diag."""
         data = np.zeros(self.nnz + 1)
-        if blocks is not None:
-            data += np.bincount(self._emap_full, weights=blocks.reshape(-1),
-                                minlength=self.nnz + 1)
+        if blocks is not None:  # element blocks alone leave the connectors' out
+            emap = self._emap_full[:blocks.size]
+            data += np.bincount(emap, weights=blocks.reshape(-1), minlength=self.nnz + 1)
         if diag is not None:
             data[:-1][self._dmap] += diag
         return scale * data[:-1] if scale != 1.0 else data[:-1]
@@ -93,6 +94,9 @@ class Model:
         mass_model = self.mass_model
         # the blend's lumped fraction μ: M = (1 - μ) M_consistent + μ M_lumped
         self.lumped_fraction = {"blended": BLEND_LUMPED, "lumped": 1.0}.get(mass_model, 0.0)
+        # springs, dampers, bars (None when the scene has none); bar weights and lumped
+        # masses go into the loading
+        self.connectors = build_connectors(case, mesh, self.loading, self.lumped_fraction)
         nn = mesh.n_nodes
         self.n_dof = 3 * nn
         fixed = np.zeros((nn, 3), bool)
@@ -122,7 +126,7 @@ class Model:
                                             ld.internal_force.copy()))
         self._t_internal: float | None = None if ld.internal_timed else 0.0
         self.edofs = (3 * mesh.conn[:, :, None] + np.arange(3)).reshape(-1, 6)  # (n_elem, 6)
-        self.pattern = Pattern(self.edofs, self.n_dof)
+        self.pattern = Pattern(with_connectors(self.edofs, self.connectors), self.n_dof)
         self.gauss_s, self.gauss_w = mesh.gauss()
         self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
                                 + ld.mass_value.sum())
@@ -194,11 +198,14 @@ class Model:
     def element_state(self, X: np.ndarray, h0: np.ndarray | None = None) -> ElementState:
         return self.elements.solve(self.chords(X), h0)
 
-    def internal_force(self, state: ElementState) -> np.ndarray:
-        """Σ_e r_e: forces the nodes supply to hold the elements, (n_dof,) N (docs/theory.md §4)."""
+    def internal_force(self, state: ElementState, X: np.ndarray | None = None) -> np.ndarray:
+        """Σ_e r_e: forces the nodes supply to hold the elements (and, given the positions X,
+        the connectors), (n_dof,) N (docs/theory.md §4, §13)."""
         r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
-        return np.bincount(self.edofs.ravel(), weights=r.reshape(-1),
-                           minlength=self.n_dof)
+        f = np.bincount(self.edofs.ravel(), weights=r.reshape(-1), minlength=self.n_dof)
+        if X is not None and self.connectors is not None:
+            f += self.connectors.force(X)
+        return f
 
     def element_lambda2(self, state: ElementState, X: np.ndarray) -> np.ndarray:
         """Irvine's λ² of each element from its stiffness along the chord, (n_elem,).
@@ -216,12 +223,16 @@ class Model:
                              np.inf)
         return np.maximum(12.0 * (ratio - 1.0), 0.0)
 
-    def stiffness_data(self, state: ElementState) -> np.ndarray:
-        """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``)."""
-        return self.pattern.assemble(state.stiffness6)
+    def stiffness_data(self, state: ElementState, X: np.ndarray | None = None) -> np.ndarray:
+        """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``);
+        with the connectors' given the positions X."""
+        k6 = state.stiffness6
+        if X is not None and self.connectors is not None:
+            k6 = extend(k6, self.connectors.stiffness_blocks(X), self.mesh.n_elements)
+        return self.pattern.assemble(k6)
 
-    def stiffness(self, state: ElementState) -> sp.csr_matrix:
-        return self.pattern.matrix(self.stiffness_data(state))
+    def stiffness(self, state: ElementState, X: np.ndarray | None = None) -> sp.csr_matrix:
+        return self.pattern.matrix(self.stiffness_data(state, X))
 
     # ------------------------------------------------------------------------------- mass
     def element_mass(self, state: ElementState) -> np.ndarray:
@@ -333,19 +344,23 @@ class Model:
         """CSR data of the mass matrix M(q) on the full dof set."""
         if self.mass_model == "lumped":
             return self.pattern.assemble(None, self.lumped_mass_diag())
-        return self.pattern.assemble(self.element_mass(state), self.diagonal_mass())
+        me = self.element_mass(state)
+        if self.connectors is not None:  # the bars' consistent-mass correction
+            me = extend(me, self.connectors.mass_blocks(), self.mesh.n_elements)
+        return self.pattern.assemble(me, self.diagonal_mass())
 
     def mass(self, state: ElementState) -> sp.csr_matrix:
         return self.pattern.matrix(self.mass_data(state))
 
     # ------------------------------------------------------------------------- reporting
-    def reactions(self, state: ElementState, t: float) -> np.ndarray:
+    def reactions(self, state: ElementState, t: float, X: np.ndarray | None = None
+                  ) -> np.ndarray:
         """Force the supports exert on the cable, (n_nodes, 3) N; NaN on free axes.
 
         Node equilibrium: support force + external load = Σ resisting forces. Inertia of point
         masses sitting on a support node is not included (the support carries it directly).
         """
-        r = self.internal_force(state) - self.nodal_load(t)
+        r = self.internal_force(state, X) - self.nodal_load(t)
         out = np.full(self.n_dof, np.nan)
         out[self.fixed] = r[self.fixed]
         return out.reshape(-1, 3)

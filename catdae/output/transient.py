@@ -8,6 +8,7 @@ import numpy as np
 from catdae._xr import xr
 from catdae.model.assembly import Model
 from catdae.output import results
+from catdae.output.connectors import with_connector_forces
 
 _GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
 
@@ -42,9 +43,10 @@ class Outputs:
             "energy_potential": (E[:, 2], "potential of gravity and constant loads"),
             "energy_total": (E.sum(axis=1), "kinetic + strain + potential"),
         }
-        return results.transient_dataset(self.prob.model.mesh, self.times[sl], self.X[sl],
-                                          self.V[sl], self.A[sl], self.T[sl], self.R[sl],
-                                          energy, attrs)
+        ds = results.transient_dataset(self.prob.model.mesh, self.times[sl], self.X[sl],
+                                       self.V[sl], self.A[sl], self.T[sl], self.R[sl],
+                                       energy, attrs)
+        return with_connector_forces(ds, self.prob.model.connectors, self.X[sl], self.V[sl])
 
 
 def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):

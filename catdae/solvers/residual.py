@@ -48,6 +48,7 @@ from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.connectors import extend
 from catdae.output.transient import potential
 
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
@@ -174,6 +175,7 @@ class TransientProblem:
         self._fidx = np.ascontiguousarray(self.fidx, np.int64)
         self._conn = np.ascontiguousarray(m.mesh.conn, np.int64)
         self._edofs = np.ascontiguousarray(m.edofs, np.int64)
+        self.connectors = m.connectors  # springs, dampers, bars (docs/theory.md §13) or None
 
     def evaluate(self, t: float, y: np.ndarray, yp: np.ndarray, res: np.ndarray) -> bool:
         """The residual at (t, y, yp) into ``res`` in one compiled pass; False (res untouched)
@@ -196,6 +198,10 @@ class TransientProblem:
         if not ok:
             self._buffers_at = None
             return False
+        if self.connectors is not None:
+            f = self.connectors.force(self._Xb, self._Vb, self._Ab, self.alpha)
+            self._force += f
+            res[1::2] += f[self.fidx]
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = (t, np.array(y[0::2], copy=True))
@@ -225,6 +231,9 @@ class TransientProblem:
         The last evaluation is cached: IDA calls the iteration matrix at the state of the
         residual it has just evaluated.
         """
+        if self.connectors is not None:  # their blocks read the positions in self.X
+            self.X[self.fidx] = q
+            self.X[self.model.fixed] = self._supports(t)[0]
         if self._cache_t == t and np.array_equal(self._cache_q, q):
             return self._cache
         at = self._buffers_at
@@ -273,6 +282,8 @@ class TransientProblem:
         out += self.m_diag * A - m.nodal_load(t)
         if damped:
             out += (self.c_diag + self.alpha * self.m_diag) * V
+        if self.connectors is not None:
+            out += self.connectors.force(self.X, V, A, self.alpha)
         return out
 
     def blocks(self, conf, cj, V=None, A=None):
@@ -304,11 +315,19 @@ class TransientProblem:
             vv += np.einsum("eki,kj->eij", qv, _S) - np.einsum("ki,ekj->eij", _S, qv)
             k6 = k6 + np.einsum("eki,kj->eij", qa, _S)
         diag = (cj + self.alpha) * self.m_diag + self.c_diag
+        cn = self.connectors
+        if cn is not None:
+            ne = m.mesh.n_elements
+            k6 = extend(k6, cn.stiffness_blocks(self.X, V), ne)
+            vv = extend(vv, cn.damping_blocks(self.X) + (cj + self.alpha) * cn.mass_blocks(), ne)
         return m.pattern.assemble(k6), m.pattern.assemble(vv, diag)
 
     def mass_data(self, conf) -> np.ndarray:
         """CSR data (full dofs) of M(q)."""
-        return self.model.pattern.assemble(conf[1], self.m_diag)
+        me = conf[1]
+        if self.connectors is not None:
+            me = extend(me, self.connectors.mass_blocks(), self.model.mesh.n_elements)
+        return self.model.pattern.assemble(me, self.m_diag)
 
     def ff(self, data: np.ndarray) -> sp.csr_matrix:
         """Free-free block (in the unknowns' order) of full-dof CSR data."""
@@ -330,7 +349,7 @@ class TransientProblem:
         if conf is None:
             return None
         V = A = None
-        if conf[3] is not None:
+        if conf[3] is not None or self.connectors is not None:
             V, A = self.full_vectors(t, y[1::2], yp[1::2])
         kdata, vdata = self.blocks(conf, cj, V, A)
         sel = self.ff_sel
@@ -438,6 +457,9 @@ class TransientProblem:
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        if self.connectors is not None:
+            kinetic += self.connectors.kinetic_correction(V)
+            strain += self.connectors.strain_energy(X)
         return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
 
