@@ -215,8 +215,7 @@ def summary(tree) -> str:
                          f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
             lines.extend(_cable_lines(ds))
         elif kind == "modal":
-            f = ", ".join(f"{v:.4g}" for v in ds.frequency.values[:10])
-            lines.append(f"[{name}] modal: frequencies (Hz): {f}")
+            lines.extend(_mode_lines(name, ds))
         elif kind == "transient":
             a = ds.attrs
             lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
@@ -229,12 +228,30 @@ def summary(tree) -> str:
                 else ds.displacement
             mag = np.sqrt((d**2).sum("axis"))
             node = str(mag.max("time").idxmax("node").values)
+            top = (f"; max tension {float(ds.tension.max()):.6g} N" if ds.sizes.get("element")
+                   else "")
             lines.append(f"    largest motion of a free node at {node}: "
-                         f"{float(mag.sel(node=node).max()):.4g} m; "
-                         f"max tension {float(ds.tension.max()):.6g} N")
+                         f"{float(mag.sel(node=node).max()):.4g} m{top}")
             if a.get("note"):
                 lines.append(f"    note: {a['note']}")
     return "\n".join(lines)
+
+
+def _mode_lines(name: str, ds) -> list[str]:
+    """One line per mode (the first 10): frequency, labels, and the damping ratio of damped
+    modes (``frequency`` is then the damped frequency)."""
+    damped = "damping_ratio" in ds
+    out = [f"[{name}] modal: {ds.sizes['mode']} modes"
+           + (" (damped: frequency Im s/2π, damping ratio -Re s/|s|)" if damped else "")]
+    plane = ds["damped_plane" if damped else "plane"].values
+    sym = ds["damped_symmetry" if damped else "symmetry"].values
+    for k in range(min(ds.sizes["mode"], 10)):
+        line = f"    mode {k + 1}: {float(ds.frequency[k]):.6g} Hz, {plane[k]}, {sym[k]}"
+        if damped:
+            line += (f", damping ratio {float(ds.damping_ratio[k]):.4g} (undamped "
+                     f"{float(ds.undamped_frequency[k]):.6g} Hz)")
+        out.append(line)
+    return out
 
 
 def _cable_lines(ds) -> list[str]:

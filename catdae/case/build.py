@@ -96,11 +96,12 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _TimePass):
         self.gravity_supports(supports)
         cables = self.cables(top.cables, materials, nodes)
         self.cable_ends |= connector_ends(top)  # what a connector holds is held
-        if not top.cables and "cables" not in bad:
+        held = top.cables or top.springs or top.dampers or top.bars
+        if not held and "cables" not in bad:
             self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "
                          '(name, ends = ["A", "B"], material, length)')
         for key in sorted(self.node_names - self.cable_ends - self.support_names):
-            if top.cables:
+            if held:
                 self.problem(("nodes", key), f"node {key!r} is not an end of any cable and "
                              "not supported: nothing holds it (remove it, or use it)")
         point_masses = self.located(top.point_masses, "point_masses", _PointMass, cables, nodes)

@@ -155,10 +155,13 @@ def build_connectors(case, mesh, loading, lumped_fraction: float) -> Connectors 
     ends = np.array([[mesh.node_index(e) for e in x.ends] for _, x in items], np.int64)
     X0 = mesh.X0
     initial = np.linalg.norm(X0[ends[:, 1]] - X0[ends[:, 0]], axis=1)  # (n,) m
-    problems = [(f"{kind}s.{x.name}.ends", f"the ends {x.ends[0]!r} and {x.ends[1]!r} coincide "
-                 "in the meshed reference configuration: the line of action is undefined"
+    where = [f"{kind}s[{i}]" for kind, group in (("spring", case.springs),
+                                                 ("damper", case.dampers), ("bar", case.bars))
+             for i in range(len(group))]
+    problems = [(f"{at}.ends", f"a {kind} of zero length: nodes {x.ends[0]!r} and "
+                 f"{x.ends[1]!r} coincide in the meshed reference configuration"
                  + ("" if kind == "damper" else "; give its length"))
-                for (kind, x), d in zip(items, initial, strict=True)
+                for at, (kind, x), d in zip(where, items, initial, strict=True)
                 if d <= 1e-9 and (kind == "damper" or x.length is None)]
     if problems:
         raise CaseError(case.path, problems)
