@@ -26,7 +26,7 @@ from catdae.errors import ConvergenceError
 from catdae.model.assembly import Model
 from catdae.model.connectors import extend
 
-DENSE_LIMIT = 1200  # size 2 n_free of the pencil up to which the dense solver is used
+DENSE_LIMIT = 200  # size 2 n_free of the pencil up to which the dense solver is used
 
 
 @dataclass
