@@ -35,14 +35,14 @@ from scipy.optimize import brentq
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 sys.path.insert(0, str(HERE.parent / "tests"))
-from reference import string_with_damper  # noqa: E402
-
 from catdae.case import case_from_dict  # noqa: E402
 from catdae.model.assembly import Model  # noqa: E402
 from catdae.model.mesh import build_mesh  # noqa: E402
 from catdae.solvers.damped_modes import solve_damped  # noqa: E402
 from catdae.solvers.modal import classify  # noqa: E402
 from catdae.solvers.static import solve_static  # noqa: E402
+
+from reference import string_with_damper  # noqa: E402
 
 SPAN, MASS, G = 100.0, 1.0, 9.81
 
@@ -195,7 +195,7 @@ string with a dashpot and the asymptotic κ/(1 + κ²) (κ = c/c_opt, c_opt = �
 
 | a/L | λ² | c/c_opt | catdae ζ/(a/L) | exact ζ/(a/L) | κ/(1+κ²) | catdae vs exact % |
 |---|---|---|---|---|---|---|
-""" + "\n".join(rows1) + f"""
+""" + "\n".join(rows1) + """
 
 ## 2. Sag (in-plane damper at a/L = 0.02, EA = 1e9 N)
 
