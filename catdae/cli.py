@@ -209,32 +209,50 @@ def summary(tree) -> str:
     lines = [f"{tree.attrs.get('title') or 'catdae run'}"]
     for name, node in tree.children.items():
         ds = node.to_dataset()
-        kind = ds.attrs.get("kind", "")
-        if kind == "static":
-            lines.append(f"[{name}] static: {ds.attrs.get('iterations')} Newton iterations, "
-                         f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
-            lines.extend(_cable_lines(ds))
-        elif kind == "modal":
-            lines.extend(_mode_lines(name, ds))
-        elif kind == "transient":
-            a = ds.attrs
-            lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
-                         f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
-                         f"{a.get('n_residual_evaluations')} residuals, "
-                         f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
-            # supports (reaction defined on some axis) are prescribed: the free nodes' motion
-            free = ds.reaction.isnull().all(("time", "axis"))
-            d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
-                else ds.displacement
-            mag = np.sqrt((d**2).sum("axis"))
-            node = str(mag.max("time").idxmax("node").values)
-            top = (f"; max tension {float(ds.tension.max()):.6g} N" if ds.sizes.get("element")
-                   else "")
-            lines.append(f"    largest motion of a free node at {node}: "
-                         f"{float(mag.sel(node=node).max()):.4g} m{top}")
-            if a.get("note"):
-                lines.append(f"    note: {a['note']}")
+        if "sweep" not in ds.dims:
+            lines.extend(_step_lines(name, ds))
+            continue
+        field = ds.attrs.get("sweep_field", "sweep")
+        lines.append(f"[{name}] swept over {field}: {ds.sizes['sweep']} values")
+        n = ds.sizes["sweep"]
+        for k, value in enumerate(ds.sweep.values):
+            one = ds.isel(sweep=k)
+            one.attrs = {key: v[k] if np.ndim(v) == 1 and len(v) == n else
+                         v.split(" | ")[k] if isinstance(v, str) and v.count(" | ") == n - 1
+                         else v for key, v in ds.attrs.items()}
+            lines.extend(_step_lines(f"{name} {field} = {float(value):.6g}", one))
     return "\n".join(lines)
+
+
+def _step_lines(name: str, ds) -> list[str]:
+    """The summary of one step's dataset (of one value of a sweep)."""
+    lines = []
+    kind = ds.attrs.get("kind", "")
+    if kind == "static":
+        lines.append(f"[{name}] static: {ds.attrs.get('iterations')} Newton iterations, "
+                     f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
+        lines.extend(_cable_lines(ds))
+    elif kind == "modal":
+        lines.extend(_mode_lines(name, ds))
+    elif kind == "transient":
+        a = ds.attrs
+        lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
+                     f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
+                     f"{a.get('n_residual_evaluations')} residuals, "
+                     f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
+        # supports (reaction defined on some axis) are prescribed: the free nodes' motion
+        free = ds.reaction.isnull().all(("time", "axis"))
+        d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
+            else ds.displacement
+        mag = np.sqrt((d**2).sum("axis"))
+        node = str(mag.max("time").idxmax("node").values)
+        top = (f"; max tension {float(ds.tension.max()):.6g} N" if ds.sizes.get("element")
+               else "")
+        lines.append(f"    largest motion of a free node at {node}: "
+                     f"{float(mag.sel(node=node).max()):.4g} m{top}")
+        if a.get("note"):
+            lines.append(f"    note: {a['note']}")
+    return lines
 
 
 def _mode_lines(name: str, ds) -> list[str]:

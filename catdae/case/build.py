@@ -36,10 +36,11 @@ from catdae.case.schema import (
     _PointMass,
     _Top,
 )
+from catdae.case.sweep import _SweepPass
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _TimePass):
+class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -108,6 +109,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _TimePass):
         loads = self.located(top.loads, "loads", _Load, cables, nodes)
         distributed = self.distributed(top.distributed_loads, cables)
         connectors = self.connectors(top, cables, nodes)
+        self.connector_items = connectors  # what a step's sweep may vary
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         steps = self.steps(top.steps)

@@ -127,10 +127,11 @@ class _StepsPass:
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
                          "mass_model": v.mass_model, "inertia": v.inertia}
             temperature = self.temperature(v.temperature_change, where)
-            if complete and temperature is not False:
+            sweep = self.sweep(v.sweep, where, self.connector_items)
+            if complete and temperature is not False and sweep is not False:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
                                 add=tuple(v.add), temperature_change=temperature,
-                                **extra))
+                                sweep=sweep, **extra))
         return out
 
     def temperature(self, raw: Any, where: tuple) -> float | FrozenMap | None | bool:

@@ -15,6 +15,7 @@ from typing import Any, Literal
 from catdae.case.build_connectors import Bar, Damper, Spring
 from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from catdae.case.messages import _found, _is_number
+from catdae.case.sweep import Sweep
 from catdae.case.timefunc import TimeFunction
 from catdae.errors import CaseError
 
@@ -234,6 +235,7 @@ class Step:
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
+    sweep: Sweep | None = None
 
     def __post_init__(self):
         if isinstance(self.temperature_change, Mapping):

@@ -111,6 +111,7 @@ class _StaticStep(BaseModel):
     temperature_change: Any = None
     add: list[Name] = []
     load_steps: Annotated[int, Field(ge=1)] = 1
+    sweep: TomlTable | None = None
 
 
 class _ModalStep(BaseModel):
@@ -121,6 +122,7 @@ class _ModalStep(BaseModel):
     temperature_change: Any = None
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
+    sweep: TomlTable | None = None
     mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
     damping: TomlTable | None = None
 
@@ -141,6 +143,7 @@ class _TransientStep(BaseModel):
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
+    sweep: TomlTable | None = None
 
 
 class _Form(BaseModel):

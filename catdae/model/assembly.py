@@ -204,7 +204,7 @@ class Model:
         r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
         f = np.bincount(self.edofs.ravel(), weights=r.reshape(-1), minlength=self.n_dof)
         if X is not None and self.connectors is not None:
-            f += self.connectors.force(X)
+            f = f + self.connectors.force(X)  # (bincount of no element gives ints)
         return f
 
     def element_lambda2(self, state: ElementState, X: np.ndarray) -> np.ndarray:

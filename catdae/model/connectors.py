@@ -60,10 +60,6 @@ class Connectors:
         """(n, 6) dofs of ends a and b, node-major."""
         return (3 * self.ends[:, :, None] + np.arange(3)).reshape(-1, 6)
 
-    @property
-    def damped(self) -> bool:
-        return bool(np.any(self.coefficient > 0.0))
-
     # ----------------------------------------------------------------------- kinematics
     def _geometry(self, X: np.ndarray):
         """(unit vectors e (n, 3), lengths d (n,)) from node positions X (n_nodes, 3)."""

@@ -91,7 +91,7 @@ def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
     (material: the cables' damping per length with the mass model's interpolation; Rayleigh:
     α M + β K). None when the scene has no damping at all."""
     cn = model.connectors
-    has_dampers = cn is not None and cn.damped
+    has_dampers = cn is not None and "damper" in cn.kinds  # (a sweep may start at c = 0)
     if damping is None and not has_dampers:
         return None
     data = np.zeros(model.pattern.nnz)
