@@ -353,8 +353,26 @@ class Case:
 
             point_masses = tuple(keep_place(p) for p in point_masses)
             loads = tuple(keep_place(p) for p in loads)
+
+            def keep_end(ref: str, what: str) -> str:  # a connector's end on a mesh node
+                if ref in self.nodes:
+                    return ref
+                cable, _, k = ref.rpartition(".")
+                k_new = int(k) * int(elements) / by_name[cable].elements
+                if k_new != int(k_new):
+                    raise CaseError(self.path, [("elements", (
+                        f"{what} ends on mesh node {ref!r}, which with {elements} elements would "
+                        f"fall between mesh nodes: use a multiple of "
+                        f"{by_name[cable].elements} elements"))])
+                return f"{cable}.{int(k_new)}"
+
+            connectors = {section: tuple(
+                replace(x, ends=tuple(keep_end(e, f"{section}.{x.name}") for e in x.ends))
+                for x in getattr(self, section)) for section in ("springs", "dampers", "bars")}
+        else:
+            connectors = {}
         case = replace(self, steps=steps, cables=cables, point_masses=point_masses,
-                       loads=loads)
+                       loads=loads, **connectors)
         problems = size_problems(case)  # more elements: the limits are judged again
         if problems:
             raise CaseError(self.path, problems)

@@ -192,3 +192,16 @@ def test_bad_connectors_get_a_located_message_and_exit_2(extra, field, words, tm
         err = capsys.readouterr().err
         assert f"{f}: {field}: {words}" in err, err
     assert not (tmp_path / "o.nc").exists()
+
+
+def test_more_elements_keep_a_connector_on_its_mesh_node(tmp_path):
+    """``elements`` overrides move an end on mesh node c.k to the same place of the new mesh,
+    and refuse a count that puts it between mesh nodes."""
+    from catdae.errors import CaseError
+
+    case = _toml(network("lumped"))
+    finer = case.with_overrides(elements=8)
+    assert [d.ends for d in finer.dampers] == [("c.4", "G")]
+    assert [b.ends for b in finer.bars] == [("c.6", "H")]
+    with pytest.raises(CaseError, match="use a multiple of 4 elements"):
+        case.with_overrides(elements=6)
