@@ -103,9 +103,9 @@ def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
         data += alpha * model.mass_data(state) + beta * model.stiffness_data(state, X)
     elif damping is not None:  # material
         ce = None
-        if model.mass_model == "linear":
+        if model.mass_model.linear:
             ce = model.linear_element_mass(damping=True)
-        elif model.mass_model != "lumped":
+        elif not model.mass_model.lumped:
             ce = model.dynamic_state(X, state.h, True)[2]
         data += model.pattern.assemble(ce, model.diagonal_mass(model.mesh.c))
     return model.pattern.matrix(data)
