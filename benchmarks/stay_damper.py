@@ -30,7 +30,6 @@ import tomllib
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import brentq
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
@@ -42,7 +41,7 @@ from catdae.solvers.damped_modes import solve_damped  # noqa: E402
 from catdae.solvers.modal import classify  # noqa: E402
 from catdae.solvers.static import solve_static  # noqa: E402
 
-from reference import string_with_damper  # noqa: E402
+from reference import damper_sag_reduction, string_with_damper  # noqa: E402
 
 SPAN, MASS, G = 100.0, 1.0, 9.81
 
@@ -106,23 +105,6 @@ def length_for(H: float, EA: float) -> float:
     return arc / (1 + H / EA)
 
 
-def irvine_reduction(lam2: float) -> float:
-    """R = 1 - 3 (λ²/ω̄) dω̄/dλ² of the first symmetric in-plane root of Irvine's
-    tan(ω̄/2) = ω̄/2 - (4/λ²)(ω̄/2)³."""
-    def root(l2):
-        f = lambda x: np.tan(x / 2) - x / 2 + 4 / l2 * (x / 2) ** 3  # noqa: E731
-        lo, hi = np.pi + 1e-9, 3 * np.pi - 1e-9
-        xs = np.linspace(lo, hi, 4001)
-        v = f(xs)
-        k = np.flatnonzero((v[:-1] * v[1:] < 0) & (np.abs(v[:-1]) < 1e3))[0]
-        return brentq(f, xs[k], xs[k + 1], xtol=1e-15)
-
-    h = 1e-4 * lam2
-    w = root(lam2)
-    dw = (root(lam2 + h) - root(lam2 - h)) / (2 * h)
-    return 1.0 - 3.0 * lam2 / w * dw
-
-
 def main() -> None:
     wall0, cpu0 = time.perf_counter(), time.process_time()
     load = os.getloadavg()
@@ -148,7 +130,7 @@ def main() -> None:
         c_opt = np.sqrt(H_ * m) / (np.pi * a)
         z = np.array([first_mode(model, sol, r * c_opt, "in-plane") for r in fine])
         k = int(np.argmax(z))
-        R = irvine_reduction(lam2)
+        R = damper_sag_reduction(lam2)
         sag[lam2] = z / a
         rows2.append(f"| {H_:.4g} | {lam2:.3g} | {z[k] / (0.5 * a):.4f} | {R:.4f} | "
                      f"{fine[k]:.3g} |")
