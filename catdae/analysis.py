@@ -245,7 +245,7 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                 "mass_model_choice": model.mass_model.choice,
                                 "status": "completed"})
     damped = solve_damped(model, state.X, est, step.modes, step.damping)
-    if damped is not None:  # docs/theory.md §14
+    if damped is not None:  # docs/theory.md §15
         modes, shapes = damped
         plane, symmetry = classify(model, state.X, shapes.real)
         ds = with_damped_modes(ds, modes, shapes, plane, symmetry).assign_attrs(

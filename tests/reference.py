@@ -409,7 +409,7 @@ def damper_sag_reduction(lambda2: float) -> float:
     """R = 1 - 3 (λ²/ω̄) dω̄/dλ² for the first symmetric in-plane mode (Irvine's root): the
     relative frequency shift when a point at a ≪ L is locked, over that of a taut string, to
     first order in a/L. The largest damping ratio a damper there can give is about ½ (a/L) R
-    (docs/theory.md §14; the argument is the document's own, the roots Irvine's)."""
+    (docs/theory.md §15; the argument is the document's own, the roots Irvine's)."""
     h = 1e-4 * lambda2
     w = irvine_symmetric_roots(lambda2, 1)[0]
     dw = (irvine_symmetric_roots(lambda2 + h, 1)[0]

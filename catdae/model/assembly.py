@@ -17,6 +17,7 @@ from catdae.case import Case
 from catdae.case.timefunc import TimeFunction
 from catdae.element.elements import Elements, ElementState, PointLoads
 from catdae.model.connectors import build_connectors, extend, with_connectors
+from catdae.model.fluid import Fluid
 from catdae.model.loading import (  # noqa: F401  (re-exported)
     Loading,
     build_loading,
@@ -121,6 +122,9 @@ class Model(MassMatrices):
         self.gauss_s, self.gauss_w = mesh.gauss()
         self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
                                 + ld.mass_value.sum())
+        # water and air (docs/theory.md §13); None for a scene without them
+        self.fluid = Fluid.of(case, mesh, self.mass_model.lumped_fraction, self.gauss_s,
+                              self.gauss_w)
 
     # -------------------------------------------------------------------------------- loads
     def set_time(self, t: float) -> None:
@@ -157,6 +161,7 @@ class Model(MassMatrices):
         funcs = [tf for _, tf in self.motions]
         funcs += [tf for tf, _ in self.loading.node_timed]
         funcs += [tf for tf, _ in self.loading.internal_timed]
+        funcs += self.fluid.time_functions() if self.fluid is not None else []
         times = sorted({float(b) for tf in funcs for b in tf.breakpoints()})
         groups: list[list[float]] = []
         for b in times:
@@ -191,7 +196,7 @@ class Model(MassMatrices):
 
     def internal_force(self, state: ElementState, X: np.ndarray | None = None) -> np.ndarray:
         """Σ_e r_e: forces the nodes supply to hold the elements (and, given the positions X,
-        the connectors), (n_dof,) N (docs/theory.md §4, §13)."""
+        the connectors), (n_dof,) N (docs/theory.md §4, §14)."""
         r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
         f = np.bincount(self.edofs.ravel(), weights=r.reshape(-1), minlength=self.n_dof)
         if X is not None and self.connectors is not None:
@@ -234,6 +239,8 @@ class Model(MassMatrices):
         masses sitting on a support node is not included (the support carries it directly).
         """
         r = self.internal_force(state, X) - self.nodal_load(t)
+        if self.fluid is not None and X is not None:  # the fluid on the support nodes
+            r += self.fluid.static(X)[0]
         out = np.full(self.n_dof, np.nan)
         out[self.fixed] = r[self.fixed]
         return out.reshape(-1, 3)

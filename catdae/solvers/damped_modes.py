@@ -1,4 +1,4 @@
-"""Damped modes about a static state: the quadratic eigenproblem (docs/theory.md §14).
+"""Damped modes about a static state: the quadratic eigenproblem (docs/theory.md §15).
 
 (s² M + s C + K) φ = 0 on the free dofs, with the tangent stiffness K, the mass M and the
 damping C (dampers, material or Rayleigh damping) of the static state. It is solved as the
@@ -120,7 +120,10 @@ def solve_damped(model: Model, X: np.ndarray, state: ElementState, n_modes: int,
         return None
     free = model.free
     k = model.stiffness(state, X)[free][:, free]
-    m = model.mass(state)[free][:, free]
+    m = model.mass(state)
+    if model.fluid is not None:  # the added mass of the water, as in the undamped modes
+        m = m + model.pattern.matrix(model.pattern.assemble(model.fluid.mass(X)))
+    m = m[free][:, free]
     modes = solve_quadratic(k, c[free][:, free], m, min(int(n_modes), free.size))
     shapes = np.zeros((modes.s.size, model.n_dof), complex)
     shapes[:, free] = modes.shape

@@ -46,8 +46,8 @@ from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
-from catdae.model.connectors import extend
 from catdae.model.settings import DampingModel
+from catdae.solvers.connector_terms import ConnectorTerms
 from catdae.solvers.layout import UnknownLayout
 from catdae.solvers.record import potential
 from catdae.solvers.start import ConsistentStart
@@ -61,7 +61,7 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return v
 
 
-class TransientProblem(ConsistentStart):
+class TransientProblem(ConsistentStart, ConnectorTerms):
     """Residual and iteration matrix of one transient step, with evaluation counters."""
 
     def __init__(self, model: Model, step, X0: np.ndarray, h0: np.ndarray | None):
@@ -145,7 +145,6 @@ class TransientProblem(ConsistentStart):
         self._fidx = np.ascontiguousarray(self.fidx, np.int64)
         self._conn = np.ascontiguousarray(m.mesh.conn, np.int64)
         self._edofs = np.ascontiguousarray(m.edofs, np.int64)
-        self.connectors = m.connectors  # springs, dampers, bars (docs/theory.md §13) or None
 
     def evaluate(self, t: float, y: np.ndarray, yp: np.ndarray, res: np.ndarray) -> bool:
         """The residual at (t, y, yp) into ``res`` in one compiled pass; False (res untouched)
@@ -168,13 +167,13 @@ class TransientProblem(ConsistentStart):
         if not ok:
             self._buffers_at = None
             return False
-        if self.connectors is not None:
-            f = self.connectors.force(self._Xb, self._Vb, self._Ab, self.alpha)
-            self._force += f
-            res[1::2] += f[self.fidx]
+        if self.connectors is not None:  # springs, dampers, bars (docs/theory.md §14)
+            self._add_connector_force(res)
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = (t, np.array(y[0::2], copy=True))
+        if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
+            res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
         return True
 
     def _conf_from_buffers(self):
@@ -201,9 +200,8 @@ class TransientProblem(ConsistentStart):
         The last evaluation is cached: IDA calls the iteration matrix at the state of the
         residual it has just evaluated.
         """
-        if self.connectors is not None:  # their blocks read the positions in self.X
-            self.X[self.fidx] = q
-            self.X[self.model.fixed] = self._supports(t)[0]
+        if self.connectors is not None:
+            self._place(t, q)
         if self._cache_t == t and np.array_equal(self._cache_q, q):
             return self._cache
         at = self._buffers_at
@@ -254,6 +252,8 @@ class TransientProblem(ConsistentStart):
             out += (self.c_diag + self.alpha * self.m_diag) * V
         if self.connectors is not None:
             out += self.connectors.force(self.X, V, A, self.alpha)
+        if m.fluid is not None:
+            out += m.fluid.evaluate(t, self._conf_X(), V, A)[0]
         return out
 
     def blocks(self, conf, cj, V=None, A=None):
@@ -285,19 +285,26 @@ class TransientProblem(ConsistentStart):
             vv += np.einsum("eki,kj->eij", qv, _S) - np.einsum("ki,ekj->eij", _S, qv)
             k6 = k6 + np.einsum("eki,kj->eij", qa, _S)
         diag = (cj + self.alpha) * self.m_diag + self.c_diag
-        cn = self.connectors
-        if cn is not None:
-            ne = m.mesh.n_elements
-            k6 = extend(k6, cn.stiffness_blocks(self.X, V), ne)
-            vv = extend(vv, cn.damping_blocks(self.X) + (cj + self.alpha) * cn.mass_blocks(), ne)
+        if self.connectors is not None:
+            k6, vv = self._connector_blocks(k6, vv, V, cj)
         return m.pattern.assemble(k6), m.pattern.assemble(vv, diag)
 
     def mass_data(self, conf) -> np.ndarray:
-        """CSR data (full dofs) of M(q)."""
-        me = conf[1]
-        if self.connectors is not None:
-            me = extend(me, self.connectors.mass_blocks(), self.model.mesh.n_elements)
-        return self.model.pattern.assemble(me, self.m_diag)
+        """CSR data (full dofs) of M(q) (with the added mass of the water, if any)."""
+        m = self.model
+        me = conf[1] if self.connectors is None else self._with_bar_mass(conf[1])
+        if m.fluid is not None:
+            z = np.zeros(self.n_dof)
+            ma = m.fluid.evaluate(self._cache_t, self._conf_X(), z, z)[1]
+            return m.pattern.assemble(me, self.m_diag) + m.pattern.assemble(ma)
+        return m.pattern.assemble(me, self.m_diag)
+
+    def _conf_X(self) -> np.ndarray:
+        """Node positions (n_dof,) of the configuration last returned by ``configuration``."""
+        X = self.X.copy()
+        X[self.fidx] = self._cache_q
+        X[self.model.fixed] = self._supports(self._cache_t)[0]
+        return X
 
     def ff(self, data: np.ndarray) -> sp.csr_matrix:
         """Free-free block (in the unknowns' order) of full-dof CSR data."""
@@ -322,6 +329,13 @@ class TransientProblem(ConsistentStart):
         if conf[3] is not None or self.connectors is not None:
             V, A = self.full_vectors(t, y[1::2], yp[1::2])
         kdata, vdata = self.blocks(conf, cj, V, A)
+        fl = self.model.fluid
+        if fl is not None:  # docs/theory.md §13: ∂(M_a a - f)/∂q and cj M_a - ∂f/∂v
+            V, A = self.full_vectors(t, y[1::2], yp[1::2])
+            _, ma, kx, kv = fl.evaluate(t, self._conf_X(), V, A, want_jac=True)
+            pat = self.model.pattern
+            kdata = kdata + pat.assemble(kx)
+            vdata = vdata + pat.assemble(cj * ma + kv)
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
@@ -369,6 +383,8 @@ class TransientProblem(ConsistentStart):
         X, V, A = self._Xb.copy(), self._Vb.copy(), self._Ab.copy()
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         f = self._force + self.m_diag * A + self._v_diag * V - p  # M A + C V + g + F - P
+        if m.fluid is not None:
+            f += m.fluid.out  # M_a A - f_fluid, left by evaluate
         reaction = np.full(self.n_dof, np.nan)
         reaction[m.fixed] = f[m.fixed]
         kinetic = 0.5 * float(self.m_diag @ (V * V))
@@ -377,8 +393,7 @@ class TransientProblem(ConsistentStart):
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
         if self.connectors is not None:
-            kinetic += self.connectors.kinetic_correction(V)
-            strain += self.connectors.strain_energy(X)
+            kinetic, strain = self._connector_energies(X, V, kinetic, strain)
         return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
 

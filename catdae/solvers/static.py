@@ -31,7 +31,17 @@ class StaticSolution:
 
 
 def _residual(model: Model, state: ElementState, p: np.ndarray, X: np.ndarray) -> np.ndarray:
-    return (model.internal_force(state, X) - p)[model.free]
+    r = model.internal_force(state, X) - p
+    if model.fluid is not None:  # buoyancy, steady current and wind drag (theory §13)
+        r += model.fluid.static(X)[0]
+    return r[model.free]
+
+
+def _stiffness(model: Model, state: ElementState, X: np.ndarray):
+    if model.fluid is None:
+        return model.stiffness(state, X)
+    return model.pattern.matrix(model.stiffness_data(state, X)
+                                + model.pattern.assemble(model.fluid.static(X)[1]))
 
 
 def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: float = 0.0,
@@ -40,6 +50,8 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
     X = np.array(X, float, copy=True)
     X.reshape(-1)[model.fixed] = model.support_positions(t)
     model.set_time(t)
+    if model.fluid is not None:
+        model.fluid.t = t
     p_full = model.nodal_load(t)
     f_full = model.elements.loads.f.copy()
     state = model.element_state(X, h0)
@@ -89,7 +101,7 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
         tscale = max(fscale, float(np.abs(state.h).max(initial=0.0)))
         if rn <= rtol * tscale:
             return True, X, state, it - 1, rn
-        k = model.stiffness(state, X)[free][:, free].tocsc()
+        k = _stiffness(model, state, X)[free][:, free].tocsc()
         dx = _solve(k, -r)
         if dx is None:
             return False, X, state, it, rn
