@@ -100,7 +100,8 @@ def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
             extend(None, cn.damping_blocks(X), model.mesh.n_elements))
     if damping is not None and damping.kind == "rayleigh":
         alpha, beta = damping.coefficients()
-        data += alpha * model.mass_data(state) + beta * model.stiffness_data(state, X)
+        # β K on the elements' stiffness alone, as in the transient residual (docs/theory.md §14)
+        data += alpha * model.mass_data(state) + beta * model.stiffness_data(state)
     elif damping is not None:  # material
         ce = None
         if model.mass_model.linear:
