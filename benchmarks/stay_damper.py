@@ -8,12 +8,12 @@ Run apart from the test suite:  python benchmarks/stay_damper.py
    and 0.05: the first mode's damping ratio ζ / (a/L) against c / c_opt, c_opt = √(Hm)/(π a/L),
    from catdae's damped modes, beside the exact taut string with a dashpot (the root of
    coth(γa) + coth(γ(L - a)) + c/√(Hm) = 0, tests/reference.py) and the asymptotic curve
-   κ/(1 + κ²), κ = c/c_opt (docs/theory.md §15).
+   κ/(1 + κ²), κ = c/c_opt (docs/theory.md §16).
 2. Sag. The same stay with EA = 1e9 N and lower tensions (λ² from 0.1 to 80), an in-plane
    (vertical) damper at a/L = 0.02 on the first symmetric in-plane mode: the largest damping
    ratio over c and the coefficient that gives it, against the estimate from the frequency
    shift when the damper point is locked, R = 1 - 3 (λ²/ω̄) dω̄/dλ² on Irvine's frequency
-   equation (docs/theory.md §15).
+   equation (docs/theory.md §16).
 
 Results go to benchmarks/stay_damper.md and the figure benchmarks/stay_damper.png.
 """
@@ -184,7 +184,7 @@ string with a dashpot and the asymptotic κ/(1 + κ²) (κ = c/c_opt, c_opt = �
 The largest damping ratio over c/c_opt (41 points from 0.1 to 10), as a fraction of the taut
 string's ½ a/L, against R = 1 - 3 (λ²/ω̄) dω̄/dλ², the relative frequency shift of Irvine's
 first symmetric in-plane mode when the damper point is locked, divided by that of a string
-(docs/theory.md §15); and where the maximum lies.
+(docs/theory.md §16); and where the maximum lies.
 
 | H (N) | λ² | catdae ζ_max / (½ a/L) | R (locked-point estimate) | c/c_opt at the maximum |
 |---|---|---|---|---|

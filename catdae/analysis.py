@@ -25,7 +25,8 @@ from catdae.interrupts import deferred
 from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
-from catdae.output import results
+from catdae.model.span import span_quantities
+from catdae.output import engineering, results
 from catdae.output.connectors import with_connector_forces, with_damped_modes
 from catdae.output.transient import as_dataset
 from catdae.solvers.damped_modes import solve_damped
@@ -91,7 +92,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 model = Model(local, mesh.heated(local, temperature), absent,
                               mass_model=step.mass_model, kind=step.kind)
                 ds = _run_step(step, model, state, writer, progress)
-            ds = rotate_back(ds, rotation)
+            ds = engineering_results(step, rotate_back(ds, rotation), case, groups,
+                                     temperature)
         except KeyboardInterrupt as exc:
             # keep what the finished steps (and a transient, up to the interrupt) computed;
             # the interrupt itself goes on
@@ -229,7 +231,27 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),
     )
-    return with_connector_forces(ds, model.connectors, sol.X)
+    ds = with_connector_forces(ds, model.connectors, sol.X)
+    return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
+                                  engineering.rated_strengths(model.case, model.mesh.cable_names))
+
+
+def engineering_results(step: Step, ds: xr.Dataset, case: Case,
+                        groups: dict[str, xr.Dataset], temperature) -> xr.Dataset:
+    """A step's group (in the case's axes) with, for a uniform temperature change, the attrs
+    ``temperature_change`` (K) and, with the case's ``reference_temperature``, ``temperature``;
+    a transient group also with its envelopes and, after a ``jump_reference`` static step,
+    the jump of each cable (catdae.output.engineering)."""
+    if not isinstance(temperature, dict) and not hasattr(temperature, "items"):
+        ds = ds.assign_attrs(temperature_change=float(temperature))
+        if case.reference_temperature is not None:
+            ds = ds.assign_attrs(temperature=case.reference_temperature + float(temperature))
+    if step.kind != "transient":
+        return ds
+    ref = groups.get(step.jump_reference) if step.jump_reference else None
+    if ref is not None:
+        ds = ds.assign_attrs(jump_reference=step.jump_reference)
+    return engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
 
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
@@ -245,7 +267,7 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                 "mass_model_choice": model.mass_model.choice,
                                 "status": "completed"})
     damped = solve_damped(model, state.X, est, step.modes, step.damping)
-    if damped is not None:  # docs/theory.md §15
+    if damped is not None:  # docs/theory.md §16
         modes, shapes = damped
         plane, symmetry = classify(model, state.X, shapes.real)
         ds = with_damped_modes(ds, modes, shapes, plane, symmetry).assign_attrs(

@@ -12,6 +12,7 @@ Contents
 ``irvine_caughey_frequencies``  linear free-vibration frequencies of a shallow level cable (Hz).
 ``taut_string_frequencies``     frequencies of a weightless taut string (Hz).
 ``string_with_damper``          exact eigenvalue of a taut string with a viscous damper.
+``level_catenary_midspan``      midspan of a level elastic catenary with a thermal strain.
 
 Formulation of the statics (chosen to differ from the package's: origin at support i, unknowns H and
 the mid-length vertical tension c, two nested scalar root solves with ``brentq`` instead of a Newton
@@ -43,6 +44,7 @@ __all__ = [
     "irvine_symmetric_roots",
     "irvine_caughey_frequencies",
     "taut_string_frequencies",
+    "level_catenary_midspan",
 ]
 
 _EPS = np.finfo(float).eps
@@ -409,9 +411,23 @@ def damper_sag_reduction(lambda2: float) -> float:
     """R = 1 - 3 (λ²/ω̄) dω̄/dλ² for the first symmetric in-plane mode (Irvine's root): the
     relative frequency shift when a point at a ≪ L is locked, over that of a taut string, to
     first order in a/L. The largest damping ratio a damper there can give is about ½ (a/L) R
-    (docs/theory.md §15; the argument is the document's own, the roots Irvine's)."""
+    (docs/theory.md §16; the argument is the document's own, the roots Irvine's)."""
     h = 1e-4 * lambda2
     w = irvine_symmetric_roots(lambda2, 1)[0]
     dw = (irvine_symmetric_roots(lambda2 + h, 1)[0]
           - irvine_symmetric_roots(lambda2 - h, 1)[0]) / (2 * h)
     return 1.0 - 3.0 * lambda2 / w * dw
+
+
+def level_catenary_midspan(L0, EA, w, eps_t, span=None):
+    """(midspan height below the supports (< 0), H) of an elastic catenary of unstrained length
+    L0 between level supports ``span`` apart (default L0) with stretch 1 + eps_t + T/EA
+    (Irvine 1981, §2.2 with a thermal strain): span = H L0/EA + (1 + eps_t) (2H/w)
+    asinh(w L0/(2H)), z_mid = (1 + eps_t) (H - sqrt(H² + (w L0/2)²))/w - w L0²/(8 EA)."""
+    span = L0 if span is None else span
+
+    def gap(H):
+        return H * L0 / EA + (1.0 + eps_t) * 2.0 * H / w * math.asinh(w * L0 / (2.0 * H)) - span
+    H = brentq(gap, 1e-6 * w * L0, 1e3 * w * L0, xtol=1e-13, rtol=1e-15)
+    return ((1.0 + eps_t) * (H - math.hypot(H, 0.5 * w * L0)) / w
+            - w * L0**2 / (8.0 * EA)), H

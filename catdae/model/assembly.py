@@ -196,7 +196,7 @@ class Model(MassMatrices):
 
     def internal_force(self, state: ElementState, X: np.ndarray | None = None) -> np.ndarray:
         """Σ_e r_e: forces the nodes supply to hold the elements (and, given the positions X,
-        the connectors), (n_dof,) N (docs/theory.md §4, §14)."""
+        the connectors), (n_dof,) N (docs/theory.md §4, §15)."""
         r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
         f = np.bincount(self.edofs.ravel(), weights=r.reshape(-1), minlength=self.n_dof)
         if X is not None and self.connectors is not None:

@@ -1,4 +1,4 @@
-"""Springs, dampers and bars between two nodes (docs/theory.md §14), batched over connectors.
+"""Springs, dampers and bars between two nodes (docs/theory.md §15), batched over connectors.
 
 A connector joins nodes a and b and acts along the line between them, e = (x_b - x_a) / d with
 d = |x_b - x_a|. Its axial force (tension positive) is

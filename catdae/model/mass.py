@@ -125,7 +125,7 @@ class MassMatrices:
         if self.mass_model.lumped:
             return self.pattern.assemble(None, self.lumped_mass_diag())
         me = self.element_mass(state)
-        if self.connectors is not None:  # the bars' consistent-mass correction (theory §14)
+        if self.connectors is not None:  # the bars' consistent-mass correction (theory §15)
             me = extend(me, self.connectors.mass_blocks(), self.mesh.n_elements)
         return self.pattern.assemble(me, self.diagonal_mass())
 

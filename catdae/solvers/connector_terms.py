@@ -1,5 +1,5 @@
 """The connectors' terms of the transient residual, iteration matrix, mass and energies
-(docs/theory.md §14): a mixin of :class:`~catdae.solvers.residual.TransientProblem`, whose
+(docs/theory.md §15): a mixin of :class:`~catdae.solvers.residual.TransientProblem`, whose
 hooks call these only when the scene has connectors (``self.connectors`` is not None)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Damped modes about a static state: the quadratic eigenproblem (docs/theory.md §15).
+"""Damped modes about a static state: the quadratic eigenproblem (docs/theory.md §16).
 
 (s² M + s C + K) φ = 0 on the free dofs, with the tangent stiffness K, the mass M and the
 damping C (dampers, material or Rayleigh damping) of the static state. It is solved as the
@@ -27,6 +27,7 @@ from catdae.model.assembly import Model
 from catdae.model.connectors import extend
 
 DENSE_LIMIT = 200  # size 2 n_free of the pencil up to which the dense solver is used
+DENSE_FALLBACK = 4000  # up to which size the dense solver takes over when ARPACK fails
 
 
 @dataclass
@@ -50,27 +51,32 @@ def solve_quadratic(k, c, m, n_modes: int) -> DampedModes:
     """The n_modes underdamped modes of lowest |s| of (s² M + s C + K) φ = 0 (sparse or
     dense square matrices of one size)."""
     n = k.shape[0]
-    if 2 * n <= DENSE_LIMIT or 2 * n_modes + 4 >= 2 * n - 1:
-        kd, cd, md = (_dense(x) for x in (k, c, m))
-        eye = np.eye(n)
-        a = np.block([[np.zeros((n, n)), eye], [-kd, -cd]])
-        b = np.block([[eye, np.zeros((n, n))], [np.zeros((n, n)), md]])
-        s, z = sla.eig(a, b)
-        solver = "dense"
-    else:
+    s = None
+    if 2 * n > DENSE_LIMIT and 2 * n_modes + 4 < 2 * n - 1:
         ks, cs, ms = (sp.csc_matrix(x) for x in (k, c, m))
         eye = sp.identity(n, format="csc")
         a = sp.bmat([[None, eye], [-ks, -cs]], format="csc")
         b = sp.bmat([[eye, None], [None, ms]], format="csc")
         lu = spla.splu(a)
         op = spla.LinearOperator(a.shape, matvec=lambda x: lu.solve(b @ x), dtype=float)
-        try:
-            nu, z = spla.eigs(op, k=min(2 * n_modes + 4, 2 * n - 2), which="LM")
+        nev = min(2 * n_modes + 4, 2 * n - 2)
+        try:  # a fixed start vector: identical runs give identical modes
+            nu, z = spla.eigs(op, k=nev, which="LM", ncv=min(2 * n - 1, max(2 * nev + 1, 40)),
+                              v0=np.linspace(1.0, 2.0, 2 * n), maxiter=100 * n)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                s = 1.0 / nu
+            solver = "sparse shift-invert"
         except (RuntimeError, spla.ArpackNoConvergence) as exc:
-            raise ConvergenceError(f"modal step: quadratic eigensolver failed ({exc})") from exc
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s = 1.0 / nu
-        solver = "sparse shift-invert"
+            if 2 * n > DENSE_FALLBACK:
+                raise ConvergenceError(f"modal step: quadratic eigensolver failed ({exc})") \
+                    from exc
+    if s is None:  # small, or ARPACK did not converge on clustered pairs: LAPACK
+        kd, cd, md = (_dense(x) for x in (k, c, m))
+        eye = np.eye(n)
+        a = np.block([[np.zeros((n, n)), eye], [-kd, -cd]])
+        b = np.block([[eye, np.zeros((n, n))], [np.zeros((n, n)), md]])
+        s, z = sla.eig(a, b)
+        solver = "dense"
     ok = np.isfinite(s)
     scale = np.abs(s[ok]).max(initial=1.0)
     keep = np.flatnonzero(ok & (s.imag > 1e-9 * scale))
@@ -100,7 +106,7 @@ def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
             extend(None, cn.damping_blocks(X), model.mesh.n_elements))
     if damping is not None and damping.kind == "rayleigh":
         alpha, beta = damping.coefficients()
-        # β K on the elements' stiffness alone, as in the transient residual (docs/theory.md §14)
+        # β K on the elements' stiffness alone, as in the transient residual (docs/theory.md §15)
         data += alpha * model.mass_data(state) + beta * model.stiffness_data(state)
     elif damping is not None:  # material
         ce = None

@@ -167,7 +167,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
         if not ok:
             self._buffers_at = None
             return False
-        if self.connectors is not None:  # springs, dampers, bars (docs/theory.md §14)
+        if self.connectors is not None:  # springs, dampers, bars (docs/theory.md §15)
             self._add_connector_force(res)
         self.h = self._hw.copy()
         self.X[:] = self._Xb
