@@ -1,4 +1,4 @@
-"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §15).
+"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §17).
 
 A Kelvin-Voigt material carries, besides its elastic tension, a viscous tension η A ε̇ on the
 rate of axial strain only. An element's strain is that of its catenary: the elastic elongation
@@ -145,8 +145,10 @@ class AxialDamping:
         axial_rates(self._conn, X, V, h, kmat, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf,
                     self.g, self.edot)
 
-    def add_residual(self, res) -> None:
-        """res (interleaved q, v rows of the unknowns) += the forces at the last ``rates``."""
+    def add_residual(self, res, X, V, h, kmat) -> None:
+        """res (interleaved q, v rows of the unknowns) += the forces at positions X and
+        velocities V (full dofs) with the solved h, kmat (``rates`` first)."""
+        self.rates(X, V, h, kmat)
         add_residual(self._conn, self.cd, self.g, self.edot, self._unknown, res)
 
     def add_forces(self, out, X=None, V=None, state=None) -> None:
