@@ -8,6 +8,7 @@ keeps everything computed before it: the exception carries the partial result tr
 from __future__ import annotations
 
 import os
+import traceback
 from collections.abc import Callable
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from catdae._xr import xr
 from catdae.case import Case, Step, load_case
 from catdae.case.frame import rotate_back, to_gravity_frame
 from catdae.element.elements import NOT_CONVERGED
-from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutputError
+from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutOfMemory, OutputError
 from catdae.interrupts import deferred
 from catdae.model import formfind
 from catdae.model.assembly import Model
@@ -93,6 +94,16 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 status += f": {ds_partial.attrs.get('status')}"
             writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
+        except MemoryError as exc:  # a step failure like any other: what was computed is kept
+            if exc.__traceback__ is not None:  # free the failed step's arrays before writing
+                traceback.clear_frames(exc.__traceback__)
+            del exc
+            err = OutOfMemory(f"step '{step.name}' ran out of memory (the machine or a limit "
+                              "such as ulimit -v or a batch scheduler's gave it less than it "
+                              "needs): use fewer elements, fewer outputs or fewer modes")
+            status = f"failed in step '{step.name}': {err}"
+            writer.keep_failed(err, results.make_tree(case, groups, status=status))
+            raise err from None
         except CatdaeError as exc:
             ds_partial = getattr(exc, "partial", None)
             if isinstance(ds_partial, xr.Dataset):
@@ -206,9 +217,13 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                   "status": "completed"})
 
 
-def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:
+def check_output(output: str | os.PathLike, case: Case | None = None,
+                 derived: tuple[str, ...] = (".partial.nc", ".failed-99.nc")) -> Path:
     """The output path, judged before any work: a regular file (or none yet) in a directory
-    catdae may write in, and not the case file itself. Raises OutputError saying why not."""
+    catdae can create files in (tried, not guessed from permissions: root cannot create files
+    under /proc), with a name short enough for every file derived from it (``derived``: the
+    suffixes that replace ``.nc``, each also written under a temporary name), and not a file the
+    case reads (the case file itself or one of its table files). Raises OutputError."""
     out = Path(output)
 
     def refuse(why: str):
@@ -216,6 +231,8 @@ def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:
 
     if str(output) == "" or out.is_dir():
         refuse("it is a directory (give a file name, e.g. -o results.nc)")
+    if "\x00" in str(output):
+        refuse("the name holds a NUL character")
     if out.exists() and not out.is_file():
         refuse("it exists and is not a regular file")
     parent = out.parent
@@ -225,18 +242,53 @@ def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:
         refuse(f"no permission to create files in {parent}")
     if out.exists() and not os.access(out, os.W_OK):
         refuse("it exists and is read-only")
-    src = getattr(case, "path", None)
-    if src is not None and out.exists() and Path(src).exists() and out.samefile(src):
-        refuse("it is the case file")
+    longest = results.longest_name(out, derived)
+    limit = results.name_max(parent)
+    if len(os.fsencode(longest)) > limit:
+        refuse(f"the name is too long: catdae also writes {longest[:24]}...{longest[-24:]} "
+               f"({len(os.fsencode(longest))} bytes) beside it, above the file system's limit of "
+               f"{limit} bytes for a file name; give a shorter name")
+    for src in read_files(case):
+        if out.exists() and src.exists() and out.samefile(src):
+            refuse("it is the case file" if src == _case_file(case) else
+                   f"it is a table file that the case reads ({src.name})")
+    try:
+        results.probe_writable(out)
+    except OSError as exc:
+        refuse(f"cannot create files in {parent}: {exc.strerror or exc}")
     return out
+
+
+def _case_file(case) -> Path | None:
+    src = getattr(case, "path", None)
+    return None if src is None else Path(src)
+
+
+def read_files(case) -> list[Path]:
+    """The files a case reads: its case file and the table files of its time functions."""
+    if case is None:
+        return []
+    files = [f] if (f := _case_file(case)) is not None else []
+    base = f.parent if f is not None else Path.cwd()
+    items = (*getattr(case, "loads", ()), *getattr(case, "distributed_loads", ()),
+             *getattr(case, "support_motions", ()))
+    for item in items:
+        for attr in ("time", "x", "y", "z"):
+            name = getattr(getattr(item, attr, None), "file", None)
+            if isinstance(name, str):
+                files.append(base / name)
+    return files
 
 
 class _Writer:
     """The one writer of a run's results (atomically, through results.write_tree).
 
     - ``write_increment``: during long transient steps, a snapshot ``<stem>.partial.nc`` whose
-      unfinished step is marked ``running``; a disk error there is remembered, not fatal.
-    - ``write_final``: the complete tree to the output; the snapshot is then removed.
+      unfinished step is marked ``running``; a disk error there is remembered, not fatal. When a
+      file of that name is already there (another run's live snapshot, or a user's file), the
+      snapshot goes to ``<stem>.partial-2.nc`` (-3, ...): never over a file it did not write.
+    - ``write_final``: the complete tree to the output; the snapshot is then removed (only one
+      that this process wrote).
     - ``keep_failed``: the tree of a failed or interrupted run, to the output, or beside it
       (``<stem>.failed.nc``, ``.failed-2.nc``, ...) when a file is there: never over a file.
     A disk error (a full disk, a lost mount) becomes one OutputError that says what was lost
@@ -250,12 +302,32 @@ class _Writer:
         self.groups = groups
         self.existed = self.output is not None and self.output.exists()
         self.snapshot_error: OSError | None = None
+        self.snapshot_written = False  # the snapshot file is this process's own
+        self._partial: Path | None = None
+        if self.output is not None:
+            results.clean_stale(self.output.parent, self.output.stem)
 
     @property
     def partial_path(self) -> Path | None:
+        """The snapshot's name, chosen at the first snapshot: the first of ``<stem>.partial.nc``,
+        ``<stem>.partial-2.nc``, ... that is not already there."""
         if self.output is None:
             return None
-        return self.output.with_name(self.output.stem + ".partial.nc")
+        if self._partial is None:
+            k = 1
+            while True:
+                p = self.output.with_name(
+                    f"{self.output.stem}.partial{'' if k == 1 else f'-{k}'}.nc")
+                if not p.exists() or k > 99:
+                    self._partial = p
+                    break
+                k += 1
+        return self._partial
+
+    def _remove_snapshot(self) -> None:
+        if self.snapshot_written:
+            self.partial_path.unlink(missing_ok=True)
+            self.snapshot_written = False
 
     def _write(self, tree: xr.DataTree, path: Path) -> None:
         with deferred():
@@ -270,14 +342,19 @@ class _Writer:
         tree = results.make_tree(self.case, {**self.groups,
                                              name: rotate_back(ds, self.rotation)},
                                  status=f"running step '{name}' (snapshot, not a result)")
+        target = self.partial_path
+        if not self.snapshot_written and target.exists():
+            return  # a file of that name appeared since: not ours to replace
         try:
-            self._write(tree, self.partial_path)
+            self._write(tree, target)
         except OSError as exc:  # the run goes on; the final write says if it fails too
             self.snapshot_error = exc
+        else:
+            self.snapshot_written = True
 
     def _lost(self, target: Path, exc: OSError, what: str) -> str:
         reason = exc.strerror or str(exc)
-        if self.partial_path.exists():
+        if self.snapshot_written and self.partial_path.exists():
             kept = f"the last snapshot of the run is kept in {self.partial_path}"
         elif self.snapshot_error is not None:
             snap = self.snapshot_error.strerror or str(self.snapshot_error)
@@ -293,7 +370,7 @@ class _Writer:
             self._write(tree, self.output)
         except OSError as exc:
             raise OutputError(self._lost(self.output, exc, "the results")) from None
-        self.partial_path.unlink(missing_ok=True)
+        self._remove_snapshot()
 
     def failed_path(self) -> Path:
         target = self.output
@@ -319,4 +396,4 @@ class _Writer:
             exc.output_error = self._lost(target, err, "the results computed so far")
             return
         exc.output_path = target
-        self.partial_path.unlink(missing_ok=True)
+        self._remove_snapshot()

@@ -20,7 +20,7 @@ from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # 
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.frame import gravity_rotation, local_axes
-from catdae.case.limits import size_problems
+from catdae.case.limits import MAX_NAME_LENGTH, size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from catdae.case.model import (
     AXES,
@@ -36,6 +36,10 @@ from catdae.case.schema import (
     _Top,
 )
 from catdae.errors import CaseError
+
+# bidirectional formatting: embeddings, overrides, isolates (and in names the marks too)
+_BIDI_OVERRIDES = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+_BIDI = _BIDI_OVERRIDES | frozenset("\u200e\u200f\u061c")
 
 
 class _Builder(_CablesPass, _StepsPass, _TimePass):
@@ -127,22 +131,35 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         return case
 
     def names(self, top: _Top) -> None:
-        """Names and texts end up in the results file: no control characters (netCDF cuts a
-        string at NUL)."""
+        """Names and texts end up in the results file, in messages and in ParaView: no control
+        characters (netCDF cuts a string at NUL), no bidirectional controls (U+202E shows a
+        name reversed), and names of at most MAX_NAME_LENGTH characters (every mesh node and
+        element label repeats its cable's name)."""
         found: list[tuple[tuple, str]] = [(("title",), top.title), (("source",), top.source)]
         found += [(("materials", k), k) for k in top.materials]
         found += [(("nodes", k), k) for k in top.nodes]
-        for section in ("cables", "point_masses", "loads", "distributed_loads"):  # steps:
-            # their names are held to the stricter rule of group names (steps())
+        for section in ("cables", "point_masses", "loads", "distributed_loads", "steps"):
+            # step names are also held to the stricter rule of group names (steps())
             found += [((section, i, "name"), item["name"]) for i, item in
-                      enumerate(getattr(top, section)) if isinstance(item.get("name"), str)]
+                      enumerate(getattr(top, section))
+                      if isinstance(item, dict) and isinstance(item.get("name"), str)]
         for where, text in found:
-            allowed = "\n\t" if where[0] in ("title", "source") else ""
+            text_field = where[0] in ("title", "source")
+            allowed = "\n\t" if text_field else ""
             bad = [c for c in text if unicodedata.category(c) == "Cc" and c not in allowed]
+            bidi = [c for c in text if c in (_BIDI_OVERRIDES if text_field else _BIDI)]
+            if where[0] == "steps" and (bad or bidi):
+                continue  # refused by the rule of group names (steps())
             if bad:
                 self.problem(where, f"expected text without control characters, found "
                              f"{_short(text)} (U+{ord(bad[0]):04X})")
-
+            elif bidi:
+                self.problem(where, "expected text without bidirectional control characters "
+                             f"(they reorder what is shown), found U+{ord(bidi[0]):04X} in "
+                             f"{_short(text.encode('unicode_escape').decode('ascii'))}")
+            elif not text_field and len(text) > MAX_NAME_LENGTH:
+                self.problem(where, f"a name of {len(text)} characters, above the limit of "
+                             f"{MAX_NAME_LENGTH}; found {_short(text)}")
 
     def gravity_vector(self, raw: Any) -> tuple[float, tuple[float, float, float]]:
         """``gravity``: a number (m/s², along -z) or ``[gx, gy, gz]``; returns (|g|, unit)."""
