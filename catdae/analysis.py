@@ -306,6 +306,10 @@ class _Writer:
         self._partial: Path | None = None
         if self.output is not None:
             results.clean_stale(self.output.parent, self.output.stem)
+            # everything a write loads (the netCDF and HDF5 libraries, dask's scheduler lookup)
+            # is loaded before any work: after an out-of-memory failure the finished steps are
+            # written without mapping new libraries
+            results.warm_writer(self.output)
 
     @property
     def partial_path(self) -> Path | None:

@@ -228,6 +228,18 @@ def probe_writable(path: Path) -> None:
     probe.unlink(missing_ok=True)
 
 
+def warm_writer(path: Path) -> None:
+    """Write (and remove) an empty netCDF file beside ``path``: loads what every write needs,
+    so that a later write (of what a run computed before it ran out of memory) does not."""
+    probe = incomplete_name(path)
+    try:
+        xr.Dataset().to_netcdf(probe, engine="netcdf4")
+    except (OSError, RuntimeError):
+        pass  # check_output judged the folder; the real write reports its own failure
+    finally:
+        probe.unlink(missing_ok=True)
+
+
 def _alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
