@@ -134,8 +134,11 @@ def say(text: str = "") -> None:
 
 
 def check_folder(folder: str | os.PathLike, what: str) -> Path:
-    """An output folder, judged before any work: created if missing, and a file can be created
-    in it (tried). Raises OutputError."""
+    """An output folder, judged before any work and without creating anything: an existing
+    folder, or a name whose nearest existing parent is a folder, where a file can be created
+    (tried, not guessed from permissions). Raises OutputError."""
+    from catdae.output.results import probe_writable
+
     path = Path(folder)
 
     def refuse(why: str):
@@ -143,15 +146,22 @@ def check_folder(folder: str | os.PathLike, what: str) -> Path:
 
     if str(folder) == "":
         refuse("no folder given")
-    if path.exists() and not path.is_dir():
-        refuse("it exists and is not a folder")
+    if "\x00" in str(folder):
+        refuse("the name holds a NUL character")
+    there = path
+    while not there.exists():
+        if there.is_symlink():
+            refuse(f"{there} is a broken symbolic link")
+        if there.parent == there:
+            break
+        there = there.parent
+    if not there.is_dir():
+        refuse("it exists and is not a folder" if there == path else
+               f"{there} is not a folder")
     try:
-        path.mkdir(parents=True, exist_ok=True)
-        from catdae.output.results import probe_writable
-
-        probe_writable(path / "probe")
+        probe_writable(there / "probe")
     except OSError as exc:
-        refuse(exc.strerror or str(exc))
+        refuse(f"cannot create files in {there}: {exc.strerror or exc}")
     return path
 
 

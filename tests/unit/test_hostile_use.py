@@ -582,6 +582,36 @@ def test_a_signalled_study_keeps_its_runs_and_writes_a_marked_partial_report(tmp
     assert not list(tmp_path.rglob("*.incomplete"))
 
 
+def test_plot_and_export_stop_alike_on_a_signal(three_kinds, tmp_path, monkeypatch, capsys):
+    """A real SIGHUP (raised in this process while a file is being written): the file is
+    finished, then the command stops with 129 and one line; no traceback, nothing half
+    written."""
+    import matplotlib.figure
+    import meshio
+
+    real_save, real_write = matplotlib.figure.Figure.savefig, meshio.write
+
+    def save_then_hang_up(self, *args, **kwargs):
+        signal.raise_signal(signal.SIGHUP)  # arrives while the file is written
+        return real_save(self, *args, **kwargs)
+
+    def write_then_hang_up(*args, **kwargs):
+        signal.raise_signal(signal.SIGHUP)
+        return real_write(*args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", save_then_hang_up)
+    monkeypatch.setattr(meshio, "write", write_then_hang_up)
+    figs, vtk = tmp_path / "figs", tmp_path / "vtk"
+    for args, folder in ((["plot", three_kinds, "-o", figs], figs),
+                         (["export", three_kinds, "--vtk", vtk], vtk)):
+        code, out, err = in_process(args, capsys)
+        assert code == 129, err
+        assert err == "catdae: interrupted by SIGHUP\n"
+        written = sorted(p for p in folder.rglob("*") if p.is_file())
+        assert len(written) == 1 and written[0].stat().st_size > 1000, written
+    assert signal.getsignal(signal.SIGHUP) == signal.SIG_DFL  # the policy ends with the command
+
+
 # -- 18. a broken pipe on stdout ----------------------------------------------------------------
 def test_a_reader_that_goes_away_does_not_fail_the_run(tmp_path):
     case = tmp_path / "c.toml"
