@@ -24,6 +24,7 @@ from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
 from catdae.output import results
+from catdae.output.files import check_output, clean_stale, warm_writer
 from catdae.output.transient import as_dataset
 from catdae.solvers.modal import solve_modal
 from catdae.solvers.static import solve_static
@@ -218,69 +219,6 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                   "status": "completed"})
 
 
-def check_output(output: str | os.PathLike, case: Case | None = None,
-                 derived: tuple[str, ...] = (".partial.nc", ".failed-99.nc")) -> Path:
-    """The output path, judged before any work: a regular file (or none yet) in a directory
-    catdae can create files in (tried, not guessed from permissions: root cannot create files
-    under /proc), with a name short enough for every file derived from it (``derived``: the
-    suffixes that replace ``.nc``, each also written under a temporary name), and not a file the
-    case reads (the case file itself or one of its table files). Raises OutputError."""
-    out = Path(output)
-
-    def refuse(why: str):
-        raise OutputError(f"cannot write the results to {out}: {why}")
-
-    if str(output) == "" or out.is_dir():
-        refuse("it is a directory (give a file name, e.g. -o results.nc)")
-    if "\x00" in str(output):
-        refuse("the name holds a NUL character")
-    if out.exists() and not out.is_file():
-        refuse("it exists and is not a regular file")
-    parent = out.parent
-    if not parent.is_dir():
-        refuse(f"no directory {parent}")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        refuse(f"no permission to create files in {parent}")
-    if out.exists() and not os.access(out, os.W_OK):
-        refuse("it exists and is read-only")
-    longest = results.longest_name(out, derived)
-    limit = results.name_max(parent)
-    if len(os.fsencode(longest)) > limit:
-        refuse(f"the name is too long: catdae also writes {longest[:24]}...{longest[-24:]} "
-               f"({len(os.fsencode(longest))} bytes) beside it, above the file system's limit of "
-               f"{limit} bytes for a file name; give a shorter name")
-    for src in read_files(case):
-        if out.exists() and src.exists() and out.samefile(src):
-            refuse("it is the case file" if src == _case_file(case) else
-                   f"it is a table file that the case reads ({src.name})")
-    try:
-        results.probe_writable(out)
-    except OSError as exc:
-        refuse(f"cannot create files in {parent}: {exc.strerror or exc}")
-    return out
-
-
-def _case_file(case) -> Path | None:
-    src = getattr(case, "path", None)
-    return None if src is None else Path(src)
-
-
-def read_files(case) -> list[Path]:
-    """The files a case reads: its case file and the table files of its time functions."""
-    if case is None:
-        return []
-    files = [f] if (f := _case_file(case)) is not None else []
-    base = f.parent if f is not None else Path.cwd()
-    items = (*getattr(case, "loads", ()), *getattr(case, "distributed_loads", ()),
-             *getattr(case, "support_motions", ()))
-    for item in items:
-        for attr in ("time", "x", "y", "z"):
-            name = getattr(getattr(item, attr, None), "file", None)
-            if isinstance(name, str):
-                files.append(base / name)
-    return files
-
-
 class _Writer:
     """The one writer of a run's results (atomically, through results.write_tree).
 
@@ -306,11 +244,11 @@ class _Writer:
         self.snapshot_written = False  # the snapshot file is this process's own
         self._partial: Path | None = None
         if self.output is not None:
-            results.clean_stale(self.output.parent, self.output.stem)
+            clean_stale(self.output.parent, self.output.stem)
             # everything a write loads (the netCDF and HDF5 libraries, dask's scheduler lookup)
             # is loaded before any work: after an out-of-memory failure the finished steps are
             # written without mapping new libraries
-            results.warm_writer(self.output)
+            warm_writer(self.output)
 
     @property
     def partial_path(self) -> Path | None:

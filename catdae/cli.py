@@ -11,7 +11,6 @@ interrupt the partial results are written and marked. A reader that closes stand
 from __future__ import annotations
 
 import argparse
-import os
 import signal
 import sys
 from importlib.resources import files
@@ -23,6 +22,8 @@ from catdae._version import __version__
 from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CaseError, CatdaeError, OutputError, ResultsError
 from catdae.interrupts import signals_as_interrupts
+from catdae.output.files import check_folder
+from catdae.progress import say
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.output.plot.WHAT
 
@@ -120,52 +121,6 @@ def main(argv: list[str] | None = None) -> int:
     return 2  # pragma: no cover - argparse requires a command
 
 
-def say(text: str = "") -> None:
-    """A line on standard output. A reader that has gone (``catdae run | head -1``: a broken
-    pipe) stops the printing, not the work: the rest of the output is discarded."""
-    try:
-        print(text, flush=True)
-    except BrokenPipeError:
-        try:  # further prints and the flush at exit go nowhere instead of failing again
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-            os.close(devnull)
-        except (OSError, ValueError):
-            pass
-
-
-def check_folder(folder: str | os.PathLike, what: str) -> Path:
-    """An output folder, judged before any work and without creating anything: an existing
-    folder, or a name whose nearest existing parent is a folder, where a file can be created
-    (tried, not guessed from permissions). Raises OutputError."""
-    from catdae.output.results import probe_writable
-
-    path = Path(folder)
-
-    def refuse(why: str):
-        raise OutputError(f"cannot write {what} to {path}: {why}")
-
-    if str(folder) == "":
-        refuse("no folder given")
-    if "\x00" in str(folder):
-        refuse("the name holds a NUL character")
-    there = path
-    while not there.exists():
-        if there.is_symlink():
-            refuse(f"{there} is a broken symbolic link")
-        if there.parent == there:
-            break
-        there = there.parent
-    if not there.is_dir():
-        refuse("it exists and is not a folder" if there == path else
-               f"{there} is not a folder")
-    try:
-        probe_writable(there / "probe")
-    except OSError as exc:
-        refuse(f"cannot create files in {there}: {exc.strerror or exc}")
-    return path
-
-
 def _say_where(exc: BaseException, when: str) -> None:
     """Where the results computed before a failure or an interrupt went, or that they are
     lost (set on the exception by the pipeline's writer)."""
@@ -226,7 +181,7 @@ def _run(args) -> int:
 
 def _plot(args) -> int:
     from catdae.output.plot import write_all
-    from catdae.output.results import read_results_file
+    from catdae.output.reading import read_results_file
 
     try:
         check_folder(args.output, "the figures")
@@ -251,7 +206,7 @@ def _plot(args) -> int:
 
 def _export(args) -> int:
     from catdae.output.export import write_vtk
-    from catdae.output.results import read_results_file
+    from catdae.output.reading import read_results_file
 
     try:
         check_folder(args.vtk, "the VTK files")

@@ -39,7 +39,7 @@ def _cells(ds: xr.Dataset) -> np.ndarray:
 def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str) -> Path:
     """One step's time series: the ``.vtu`` files and the ``.pvd`` collection; returns the
     collection's path."""
-    from catdae.output.results import step_problem
+    from catdae.output.reading import step_problem
 
     if (why := step_problem(ds)) is not None:
         raise ExportError(f"step {name[:60]!r}: {why}")

@@ -56,7 +56,7 @@ _KINDS = {"profile": ("static", "transient"), "tension": ("static", "transient")
 def _ds(data, figure: str | None = None) -> xr.Dataset:
     """The step's Dataset, judged for the figure: PlotError unless it is a step group of a
     kind that makes it, with the variables of that kind (results.step_problem)."""
-    from catdae.output.results import step_problem
+    from catdae.output.reading import step_problem
 
     if isinstance(data, xr.DataTree):
         data = data.to_dataset()
@@ -291,7 +291,7 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
                         f"{', '.join(WHAT)}")
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    from catdae.output.results import step_problem
+    from catdae.output.reading import step_problem
 
     for name in names:
         ds = tree[name].to_dataset()

@@ -8,11 +8,8 @@ into place, so an existing file is only ever replaced by a complete one.
 from __future__ import annotations
 
 import errno
-import glob
 import os
-import re
 import shutil
-import uuid
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -21,6 +18,7 @@ import numpy as np
 from catdae._version import __version__
 from catdae._xr import xr
 from catdae.model.mesh import AXES, Mesh
+from catdae.output.files import INCOMPLETE_SUFFIX, clean_stale, incomplete_name  # noqa: F401
 
 CONVENTIONS = "CF-1.10"
 # CF §4.4: a time coordinate has units "<unit> since <epoch>". The case's clock has no date: its
@@ -189,92 +187,6 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 
 
-INCOMPLETE_SUFFIX = ".incomplete"
-"""The temporary name ends so: ``<name>.<pid>-<random>.incomplete``, never ``.nc``."""
-
-
-def incomplete_name(path: Path) -> Path:
-    """The temporary file that :func:`write_atomic` writes before moving it to ``path``. Only a
-    process killed outright (SIGKILL, power loss) leaves one behind; its name says what it is
-    and no ``*.nc`` pattern matches it, so it is never taken for a result."""
-    return path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}{INCOMPLETE_SUFFIX}")
-
-
-_INCOMPLETE_TAIL = f".{2**22 - 1}-{'f' * 8}{INCOMPLETE_SUFFIX}"  # the longest pid (Linux)
-
-
-def longest_name(path: Path, derived: tuple[str, ...] = ()) -> str:
-    """The longest file name that writing ``path`` (and the files derived from it: ``derived``
-    suffixes in place of ``.nc``) creates, temporary names included."""
-    names = [path.name] + [path.stem + d for d in derived]
-    return max(names, key=lambda n: len(os.fsencode(n))) + _INCOMPLETE_TAIL
-
-
-def name_max(folder: Path) -> int:
-    """The file system's limit on the length of a file name in ``folder`` (bytes)."""
-    try:
-        return int(os.pathconf(folder, "PC_NAME_MAX"))
-    except (OSError, ValueError):
-        return 255
-
-
-def probe_writable(path: Path) -> None:
-    """Create (and remove) a temporary file beside ``path``: whether files can be created
-    there, found by trying (permissions alone do not say it: root under /proc, a read-only
-    mount). Raises OSError."""
-    probe = incomplete_name(path)
-    fd = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    os.close(fd)
-    probe.unlink(missing_ok=True)
-
-
-def warm_writer(path: Path) -> None:
-    """Write (and remove) an empty netCDF file beside ``path``: loads what every write needs,
-    so that a later write (of what a run computed before it ran out of memory) does not."""
-    probe = incomplete_name(path)
-    try:
-        xr.Dataset().to_netcdf(probe, engine="netcdf4")
-    except (OSError, RuntimeError):
-        pass  # check_output judged the folder; the real write reports its own failure
-    finally:
-        probe.unlink(missing_ok=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError, ValueError):
-        return pid > 0  # someone else's process: alive
-    return True
-
-
-_STALE = re.compile(r"\.(\d{1,10})-[0-9a-f]{8}" + re.escape(INCOMPLETE_SUFFIX) + "$")
-
-
-def clean_stale(folder: Path, prefix: str) -> list[Path]:
-    """Remove the temporary files ``<prefix>*.<pid>-<random>.incomplete`` in ``folder`` left
-    by processes that no longer run (killed outright while writing). A live process's file is
-    never touched. Returns the files removed."""
-    removed = []
-    try:
-        candidates = list(folder.glob(f"{glob.escape(prefix)}*{INCOMPLETE_SUFFIX}"))
-    except OSError:
-        return removed
-    for f in candidates:
-        m = _STALE.search(f.name)
-        if m is None or _alive(int(m[1])):
-            continue
-        try:
-            if f.is_file() and not f.is_symlink():
-                f.unlink()
-                removed.append(f)
-        except OSError:
-            pass
-    return removed
-
-
 def write_atomic(data: xr.DataTree | xr.Dataset, path: str | os.PathLike) -> Path:
     """Write netCDF-4 atomically: a temporary file beside the target (:func:`incomplete_name`),
     moved over it, so that a crash never leaves half a file and an existing file is only
@@ -320,81 +232,4 @@ def read_tree(path: str | os.PathLike) -> xr.DataTree:
         for name in node.dims:
             if name in node.variables and node.variables[name].dtype.kind == "f":
                 node.variables[name].encoding["_FillValue"] = None
-    return tree
-
-
-_NEEDS = {  # what each kind of step group holds (name -> dims), as the readers use it
-    "static": {"position": ("node", "axis"), "displacement": ("node", "axis"),
-               "tension": ("element", "end"), "reaction": ("node", "axis"),
-               "element_node": ("element", "end"), "element_cable": ("element",),
-               "element_s": ("element", "end")},
-    "transient": {"time": ("time",), "position": ("time", "node", "axis"),
-                  "displacement": ("time", "node", "axis"),
-                  "velocity": ("time", "node", "axis"),
-                  "acceleration": ("time", "node", "axis"),
-                  "tension": ("time", "element", "end"),
-                  "reaction": ("time", "node", "axis"),
-                  "element_node": ("element", "end"), "element_cable": ("element",),
-                  "element_s": ("element", "end")},
-    "modal": {"frequency": ("mode",), "shape": ("mode", "node", "axis"),
-              "node_cable": ("node",), "s": ("node",)},
-}
-_LABELS = ("node", "axis", "element_node", "element_cable", "node_cable")
-
-
-def step_problem(ds: xr.Dataset) -> str | None:
-    """Why a group is not a step of a catdae results file (a foreign or half-written file), or
-    None: its ``kind`` and the variables and dimensions of that kind (case-format.md,
-    "Results"), numbers where numbers are expected, element ends that are nodes."""
-    kind = ds.attrs.get("kind")
-    if kind not in _NEEDS:
-        return (f"it has no kind of step (static, modal or transient; found {kind!r})"
-                if kind is not None else "it is not a catdae step (no attribute 'kind')")
-    names = set(ds.variables)
-    for name, dims in {"node": ("node",), "axis": ("axis",), **_NEEDS[kind]}.items():
-        if name not in names:
-            return f"a {kind} step without the variable {name!r}"
-        if tuple(ds[name].dims) != dims:
-            return (f"its variable {name!r} has dimensions {tuple(ds[name].dims)}, expected "
-                    f"{dims}")
-        want_text = name in _LABELS
-        if want_text != (ds[name].dtype.kind in "OUS"):
-            return f"its variable {name!r} holds {'numbers' if want_text else 'text'}"
-    if list(map(str, ds.axis.values)) != list(AXES):
-        return f"its axes are {list(map(str, ds.axis.values))}, expected {list(AXES)}"
-    if ds.sizes["node"] == 0 or (kind == "transient" and ds.sizes["time"] == 0):
-        return "it holds no nodes or no output times"
-    if "element_node" in names:
-        missing = set(map(str, ds.element_node.values.ravel())) - set(map(str, ds.node.values))
-        if missing:
-            return f"an element ends at {sorted(missing)[0][:40]!r}, which is not a node"
-    return None
-
-
-def read_results_file(path: str | os.PathLike) -> xr.DataTree:
-    """A results file for ``catdae plot`` and ``export``: read, and judged to be catdae's
-    (at least one step group, each with the variables of its kind). Raises ResultsError
-    ("cannot read ...") for a missing, empty, truncated, corrupted or foreign file."""
-    from catdae.errors import ResultsError
-
-    path = Path(path)
-    if not path.is_file():
-        why = "no such file" if not path.exists() else "not a regular file"
-        raise ResultsError(f"cannot read {path}: {why}")
-    try:
-        tree = read_tree(path)
-    except MemoryError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - the netCDF/HDF5 libraries raise many kinds
-        why = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
-        raise ResultsError(f"cannot read {path}: not a readable netCDF-4 results file "
-                           f"({why})") from None
-    if not tree.children:
-        raise ResultsError(f"cannot read {path}: it holds no step results (no groups; is it "
-                           "a file written by catdae run?)")
-    for name, node in tree.children.items():
-        why = step_problem(node.to_dataset())
-        if why is not None:
-            raise ResultsError(f"cannot read {path}: group {name[:60]!r}: {why} (not a "
-                               "catdae results file, or a half-written one)")
     return tree

@@ -91,9 +91,9 @@ def main(argv: list[str] | None = None) -> int:
     129 SIGHUP: the finished runs are kept in the store and a partial report marked
     'interrupted' is written)."""
     args = _parser().parse_args(argv)
-    from catdae.analysis import check_output
     from catdae.case import load_case
-    from catdae.cli import check_folder, say
+    from catdae.output.files import check_folder, check_output
+    from catdae.progress import say
 
     store = None
     try:
