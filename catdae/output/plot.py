@@ -71,6 +71,9 @@ def _ds(data, figure: str | None = None) -> xr.Dataset:
         if data.attrs["kind"] not in kinds:
             raise PlotError(f"a {figure} figure needs a {' or '.join(kinds)} step, found a "
                             f"{data.attrs['kind']} step")
+        if "time" in data.dims and data.sizes["time"] == 0:
+            raise PlotError(f"the step has no outputs to draw (status: "
+                            f"{str(data.attrs.get('status', ''))[:80]})")
     return data
 
 

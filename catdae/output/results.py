@@ -144,7 +144,7 @@ def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, 
     coords = _coords(mesh)
     coords["time"] = xr.Variable("time", np.asarray(time, float), TIME_ATTRS,
                                  encoding={"_FillValue": None})  # CF: none on coordinates
-    X = np.asarray(X).reshape(len(time), -1, 3)
+    X = np.asarray(X).reshape(len(time), mesh.X0.shape[0], 3)  # 0 outputs too: an early stop
     data = {
         "position": _var(d, X, "m", "node position"),
         "displacement": _var(d, X - mesh.X0[None], "m", "displacement from reference_position"),

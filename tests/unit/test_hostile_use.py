@@ -515,6 +515,7 @@ def stop(proc, sig, chunks, reader) -> tuple[int, str]:
             proc.kill()
             proc.wait()
     reader.join(30)
+    proc.stderr.close()
     return code, b"".join(chunks).decode(errors="replace")
 
 
@@ -558,15 +559,24 @@ def test_a_signalled_study_keeps_its_runs_and_writes_a_marked_partial_report(tmp
         while line := proc.stdout.readline():
             lines.append(line)
 
-    threading.Thread(target=read_out, daemon=True).start()
-    deadline = time.monotonic() + 240
-    while not any(b"reference:" in x for x in lines):  # the reference has finished
-        assert proc.poll() is None, proc.stderr.read().decode()
-        assert time.monotonic() < deadline
-        time.sleep(0.05)
-    proc.send_signal(sig)
-    code = proc.wait(120)
-    err = proc.stderr.read().decode()
+    reader = threading.Thread(target=read_out, daemon=True)
+    reader.start()
+    try:
+        deadline = time.monotonic() + 240
+        while not any(b"reference:" in x for x in lines):  # the reference has finished
+            assert proc.poll() is None, proc.stderr.read().decode()
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        proc.send_signal(sig)
+        code = proc.wait(120)
+        err = proc.stderr.read().decode()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        reader.join(30)
+        proc.stdout.close()
+        proc.stderr.close()
     assert code == 128 + sig, err
     assert "Traceback" not in err
     assert f"catdae study: interrupted by {signal.Signals(sig).name}" in err
@@ -610,6 +620,31 @@ def test_plot_and_export_stop_alike_on_a_signal(three_kinds, tmp_path, monkeypat
         written = sorted(p for p in folder.rglob("*") if p.is_file())
         assert len(written) == 1 and written[0].stat().st_size > 1000, written
     assert signal.getsignal(signal.SIGHUP) == signal.SIG_DFL  # the policy ends with the command
+
+
+def test_a_signal_before_the_first_output_of_a_transient_keeps_the_run(tmp_path, monkeypatch,
+                                                                      capsys):
+    """A signal as a transient step starts (before its first output, here as IDA is made):
+    exit 143 and the finished static step written, as at any other moment (it was a
+    traceback: a dataset of no outputs could not be built)."""
+    import catdae.solvers.transient
+
+    def stopped(*args, **kwargs):
+        raise catdae.Interrupted(signal.SIGTERM)
+
+    monkeypatch.setattr(catdae.solvers.transient, "IDA", stopped)
+    case = tmp_path / "c.toml"
+    case.write_text(short_dynamic())
+    out = tmp_path / "c.nc"
+    code, _, err = in_process(["run", case, "-o", out], capsys)
+    assert code == 143, err
+    assert err == ("catdae: interrupted by SIGTERM\ncatdae: results computed before the "
+                   f"interrupt were written to {out}\n")
+    tree = catdae.read_results(out)
+    assert tree["st"].to_dataset().attrs["status"] == "completed"
+    assert tree["dyn"].to_dataset().sizes["time"] == 0
+    code, _, err = in_process(["plot", out, "-o", tmp_path / "f", "--step", "dyn"], capsys)
+    assert code == 2 and "the step has no outputs to draw" in err
 
 
 # -- 18. a broken pipe on stdout ----------------------------------------------------------------
