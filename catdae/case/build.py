@@ -43,6 +43,16 @@ _BIDI_OVERRIDES = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2
 _BIDI = _BIDI_OVERRIDES | frozenset("\u200e\u200f\u061c")
 
 
+MAX_MESSAGE = 400  # characters of one problem: a name of 100 000 characters is not repeated
+
+
+def _bounded(message: str) -> str:
+    """A message cut to MAX_MESSAGE characters, saying so (it may quote a long name)."""
+    if len(message) <= MAX_MESSAGE:
+        return message
+    return f"{message[:MAX_MESSAGE - 40]}... (message cut, {len(message)} characters)"
+
+
 class _Builder(_CablesPass, _StepsPass, _TimePass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
@@ -52,7 +62,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         self.problems: list[tuple[str, str]] = []
 
     def problem(self, parts: Iterable[str | int], message: str) -> None:
-        self.problems.append((_fmt_path(parts), message))
+        self.problems.append((_fmt_path(parts), _bounded(message)))
 
     def validate(self, model: type[BaseModel], data: Any, prefix: tuple,
                  foreign: Mapping[str, str] | None = None) -> tuple[Any, bool]:
