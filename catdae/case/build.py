@@ -17,8 +17,10 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_fluid import _FluidPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
+from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
 from catdae.case.limits import MAX_NAME_LENGTH, size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
@@ -53,7 +55,7 @@ def _bounded(message: str) -> str:
     return f"{message[:MAX_MESSAGE - 40]}... (message cut, {len(message)} characters)"
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass):
+class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -122,6 +124,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         steps = self.steps(top.steps)
+        water, air = self.water(top.water), self.air(top.air)
+        self.fluid_lines(top.materials, water, air)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -134,7 +138,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), path=self.path, text=text, name=name,
+            steps=tuple(steps), water=water, air=air, path=self.path, text=text, name=name,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -213,7 +217,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
-                                    float(m.thermal_expansion))
+                                    float(m.thermal_expansion), **line_fluid(m))
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:

@@ -14,6 +14,7 @@ from typing import Any, Literal
 
 from pydantic import ValidationError
 
+from catdae.case.fluid import Air, Water
 from catdae.case.limits import size_problems
 from catdae.case.messages import _message
 from catdae.case.names import mesh_node, split_mesh_node
@@ -68,6 +69,9 @@ class Material:
     N per metre of unstrained cable (default ``mass * gravity``); ``damping`` material damping per
     unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``);
     ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT.
+    In water or air (docs/theory.md §13): ``diameter`` d, m (0: the line feels no fluid), the
+    drag coefficients ``drag_normal`` and ``drag_axial`` and the added-mass coefficients
+    ``added_mass_normal`` and ``added_mass_axial`` (MoorDyn's Cd, CdAx, Ca, CaAx).
     """
 
     name: str
@@ -76,6 +80,11 @@ class Material:
     weight: float
     damping: float = 0.0
     thermal_expansion: float = 0.0
+    diameter: float = 0.0
+    drag_normal: float = 0.0
+    drag_axial: float = 0.0
+    added_mass_normal: float = 0.0
+    added_mass_axial: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -249,7 +258,8 @@ class Case:
 
     ``nodes`` maps names to ``(x, y, z)`` in m; ``supports`` maps node names to their fixed axes
     (a subset of ``AXES`` in x, y, z order); ``gravity`` in m/s² acts along the unit vector
-    ``gravity_direction`` (default -z). ``path`` is the
+    ``gravity_direction`` (default -z); ``water`` and ``air`` the fluids around the cables
+    (``None``: none). ``path`` is the
     case file (``None`` for text), ``text`` its TOML text, ``name`` its stem. Constructing a Case
     directly skips validation; mappings and sequences are frozen either way.
     """
@@ -267,6 +277,8 @@ class Case:
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
     steps: tuple[Step, ...] = ()
+    water: Water | None = None  # docs/case-format.md, "Water and air"
+    air: Air | None = None
     path: str | None = None
     text: str = field(default="", repr=False)
     name: str = "case"
