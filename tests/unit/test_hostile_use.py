@@ -30,7 +30,7 @@ import catdae
 import catdae.output.results
 from catdae.cli import main
 
-from scene_toml import cable_scene, modal_step, static_step, transient_step
+from scene_toml import cable_scene, long_transient, modal_step, static_step, transient_step
 
 PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
 
@@ -53,12 +53,9 @@ def short_dynamic(duration=0.2) -> str:
 
 
 def long_case(path: Path, duration: float = 1000.0) -> Path:
-    """A weightless taut cable, pushed sideways, then released for ``duration`` seconds
-    (minutes of wall time: always interrupted long before its end)."""
-    path.write_text(cable_scene(
-        B=(10.0, 0.0, 0.0), L0=10.0 / 1.1, EA=1e4, mass=2.0, weight=0.0, elements=2,
-        extra=PUSH, steps=static_step("static") + transient_step(
-            "dyn", duration, 0.01, rtol=1e-6, atol=1e-9, remove=["push"])))
+    """scene_toml.long_transient written to ``path``: a run of it is interrupted long before
+    its end."""
+    path.write_text(long_transient(duration))
     return path
 
 
