@@ -48,6 +48,12 @@ class OutOfMemory(CatdaeError):
     """A step needed more memory than the process was given (a MemoryError): the step fails,
     what the steps before it computed is written, and the status says why."""
 
+    @classmethod
+    def in_step(cls, name: str) -> OutOfMemory:
+        return cls(f"step '{name}' ran out of memory (the machine or a limit such as ulimit -v "
+                   "or a batch scheduler's gave it less than it needs): use fewer elements, "
+                   "fewer outputs or fewer modes")
+
 
 class ResultsError(CatdaeError):
     """A results file that cannot be read: missing, empty, truncated, corrupted, or not one

@@ -17,11 +17,13 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_connectors import _ConnectorsPass, connector_ends
 from catdae.case.build_fluid import _FluidPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
+from catdae.case.ground import _GroundPass
 from catdae.case.limits import MAX_NAME_LENGTH, size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from catdae.case.model import (
@@ -38,6 +40,7 @@ from catdae.case.schema import (
     _PointMass,
     _Top,
 )
+from catdae.case.sweep import _SweepPass
 from catdae.errors import CaseError
 
 # bidirectional formatting: embeddings, overrides, isolates (and in names the marks too)
@@ -55,7 +58,8 @@ def _bounded(message: str) -> str:
     return f"{message[:MAX_MESSAGE - 40]}... (message cut, {len(message)} characters)"
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
+class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, _FluidPass,
+               _GroundPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -111,18 +115,24 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
         supports = self.supports(top.supports, nodes)
         self.gravity_supports(supports)
         cables = self.cables(top.cables, materials, nodes)
-        if not top.cables and "cables" not in bad:
+        self.cable_ends |= connector_ends(top)  # what a connector holds is held
+        held = top.cables or top.springs or top.dampers or top.bars
+        if not held and "cables" not in bad:
             self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "
                          '(name, ends = ["A", "B"], material, length)')
         for key in sorted(self.node_names - self.cable_ends - self.support_names):
-            if top.cables:
+            if held:
                 self.problem(("nodes", key), f"node {key!r} is not an end of any cable and "
                              "not supported: nothing holds it (remove it, or use it)")
         point_masses = self.located(top.point_masses, "point_masses", _PointMass, cables, nodes)
         loads = self.located(top.loads, "loads", _Load, cables, nodes)
         distributed = self.distributed(top.distributed_loads, cables)
+        connectors = self.connectors(top, cables, nodes)
+        self.connector_items = connectors  # what a step's sweep may vary
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
+        self.reference_temperature = top.reference_temperature
+        ground = self.ground(top.ground, self.gravity_direction)
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
         self.fluid_lines(top.materials, water, air)
@@ -138,7 +148,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), water=water, air=air, path=self.path, text=text, name=name,
+            **connectors, steps=tuple(steps), water=water, air=air, path=self.path, text=text,
+            name=name, reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -153,7 +164,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
         found: list[tuple[tuple, str]] = [(("title",), top.title), (("source",), top.source)]
         found += [(("materials", k), k) for k in top.materials]
         found += [(("nodes", k), k) for k in top.nodes]
-        for section in ("cables", "point_masses", "loads", "distributed_loads", "steps"):
+        for section in ("cables", "point_masses", "loads", "distributed_loads", "springs",
+                        "dampers", "bars", "steps"):
             # step names are also held to the stricter rule of group names (steps())
             found += [((section, i, "name"), item["name"]) for i, item in
                       enumerate(getattr(top, section))
@@ -217,7 +229,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
-                                    float(m.thermal_expansion), **line_fluid(m))
+                                    float(m.thermal_expansion), **line_fluid(m),
+                                    rated_strength=m.rated_strength)
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:

@@ -26,6 +26,16 @@ def incomplete_name(path: Path) -> Path:
     return path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}{INCOMPLETE_SUFFIX}")
 
 
+def free_name(path: Path, tag: str) -> Path:
+    """The first of ``<stem><tag>.nc``, ``<stem><tag>-2.nc``, ... (up to -99) that is not
+    there yet: a file beside ``path`` that replaces none."""
+    for k in range(1, 100):
+        p = path.with_name(f"{path.stem}{tag}{'' if k == 1 else f'-{k}'}.nc")
+        if not p.exists():
+            return p
+    return p
+
+
 _INCOMPLETE_TAIL = f".{2**22 - 1}-{'f' * 8}{INCOMPLETE_SUFFIX}"  # the longest pid (Linux)
 
 

@@ -114,8 +114,9 @@ def test_group_kinds_and_dimensions(written):
     assert md.shape.dims == ("mode", "node", "axis")
     tr = back["tapped"].to_dataset()
     assert tr.position.dims == ("time", "node", "axis")
-    # CF time: seconds since a nominal epoch, kept as seconds (floats) by read_results
-    assert tr.time.attrs["units"] == "seconds since 1970-01-01 00:00:00"
+    # CF time: seconds since a nominal epoch (UDUNITS' keyword in any case; xarray decodes
+    # only a lower-case "since"), kept as seconds (floats) by read_results and plain xarray
+    assert tr.time.attrs["units"].lower() == "seconds since 1970-01-01 00:00:00"
     assert tr.time.attrs["standard_name"] == "time" and tr.time.dtype == np.float64
     np.testing.assert_allclose(tr.time.values, [0.0, 0.01, 0.02, 0.03, 0.04], atol=1e-12)
     assert tr.attrs["status"] == "completed"
