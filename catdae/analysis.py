@@ -177,6 +177,10 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
 
 
 def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
+    if model.case.seabed is not None:
+        from catdae.solvers.seabed_static import static_seabed_step
+
+        return static_seabed_step(step, model, state, _static_result)
     sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
     return _static_result(model, state, sol)
 

@@ -17,6 +17,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_seabed import _SeabedPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.frame import gravity_rotation, local_axes
@@ -38,7 +39,7 @@ from catdae.case.schema import (
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass):
+class _Builder(_CablesPass, _StepsPass, _TimePass, _SeabedPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -107,6 +108,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         steps = self.steps(top.steps)
+        seabed = self.seabed(top.seabed, nodes, supports, materials, steps)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -119,7 +121,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), path=self.path, text=text, name=name,
+            steps=tuple(steps), seabed=seabed, path=self.path, text=text, name=name,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:

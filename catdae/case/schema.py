@@ -38,6 +38,7 @@ class _Top(BaseModel):
     distributed_loads: list[TomlTable] = []
     support_motions: list[TomlTable] = []
     steps: list[TomlTable] = []
+    seabed: TomlTable | None = None
 
 
 class _Material(BaseModel):

@@ -18,7 +18,8 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-KERNEL_MODULES = ("element/catenary", "element/mass", "element/residual_kernel")
+KERNEL_MODULES = ("element/catenary", "element/mass", "element/residual_kernel",
+                  "element/grounded")
 _STAMP = "catdae-kernels.sha256"
 
 
