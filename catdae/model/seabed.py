@@ -167,3 +167,187 @@ class GroundedModel(Model):
         out = np.full(self.n_dof, np.nan)
         out[self.base.fixed] = r[self.base.fixed]
         return out.reshape(-1, 3)
+
+
+class SeabedContact:
+    """Penalty contact of the free nodes with the seabed (docs/theory.md §13.5).
+
+    Node k has the contact area a_k = Σ_e ½ L0_e d_e of its elements (d the contact width,
+    the materials' ``diameter``). Below the seabed (δ = z_b - z > 0) the seabed pushes it up
+    with N = a k δ and damps it with -a c ż (MoorDyn's kBot, cBot); a smoothed Coulomb
+    friction opposes the horizontal velocity u: F_f = -N M u / sqrt(|u|² + v_s²), with
+    M = μ_a ê êᵀ + μ_l (I - ê êᵀ) on the horizontal plane, ê the horizontal direction of the
+    line at the node (of its chord through the neighbouring nodes). Below v_s friction is
+    viscous (N μ / v_s), well above it Coulomb's μ N.
+    """
+
+    def __init__(self, seabed, mesh, free_z: np.ndarray, area: np.ndarray,
+                 stiffness: float | None = None):
+        """``free_z`` (n_nodes,) bool: nodes whose z is free; ``area`` (n_nodes,) m²."""
+        self.zb = seabed.z
+        self.k = seabed.stiffness if stiffness is None else stiffness
+        self.c = seabed.damping if stiffness is None else 0.0
+        self.mu_a = seabed.friction_axial if stiffness is None else 0.0
+        self.mu_l = seabed.friction_lateral if stiffness is None else 0.0
+        self.vs = seabed.friction_velocity
+        self.nodes = np.flatnonzero(free_z & (area > 0))  # (p,)
+        self.area = area[self.nodes]
+        self.friction = self.mu_a > 0 or self.mu_l > 0
+        # neighbours for the line direction: the other ends of the node's elements
+        conn = mesh.conn
+        nbr = np.full((mesh.n_nodes, 2), -1, np.int64)
+        for col, other in ((0, 1), (1, 0)):
+            nbr[conn[:, col], other] = conn[:, other]
+        nb = nbr[self.nodes]
+        self.nb_a = np.where(nb[:, 0] >= 0, nb[:, 0], self.nodes)
+        self.nb_b = np.where(nb[:, 1] >= 0, nb[:, 1], self.nodes)
+
+    @classmethod
+    def of_model(cls, model: Model, stiffness: float | None = None,
+                 width: np.ndarray | None = None) -> SeabedContact:
+        """The contact of ``model``'s free nodes; ``width`` (n_elem,) m defaults to the
+        materials' diameters; with ``stiffness`` (N/m per m² of area) a frictionless,
+        undamped contact of that stiffness (the rigid statics' first approach)."""
+        mesh = model.mesh
+        if width is None:
+            width = np.array([getattr(model.case.material_of(c), "diameter", None) or 0.0
+                              for c in model.case.cables])[mesh.cable_of_element]
+        area = np.zeros(mesh.n_nodes)
+        np.add.at(area, mesh.conn.ravel(), np.repeat(0.5 * mesh.L0 * width, 2))
+        return cls(model.case.seabed, mesh, ~model.fixed_mask[:, 2], area, stiffness)
+
+    def _direction(self, X):
+        d = X[self.nb_b, :2] - X[self.nb_a, :2]
+        n = np.hypot(d[:, 0], d[:, 1])
+        return d / np.where(n > 0, n, 1.0)[:, None]
+
+    def forces(self, X: np.ndarray, V: np.ndarray | None = None):
+        """Force of the seabed on the nodes, (n_nodes, 3) N, and the contact data for the
+        derivatives: (in contact mask (p,), N (p,), friction factor pieces)."""
+        z = X[self.nodes, 2]
+        delta = self.zb - z
+        on = delta > 0.0
+        out = np.zeros_like(X)
+        n_force = np.where(on, self.area * self.k * delta, 0.0)  # (p,) N
+        fz = n_force.copy()
+        if V is not None and self.c:
+            fz -= np.where(on, self.area * self.c * V[self.nodes, 2], 0.0)
+        out[self.nodes, 2] = fz
+        if V is not None and self.friction and on.any():
+            u = V[self.nodes, :2]
+            e = self._direction(X)
+            ua = np.einsum("pi,pi->p", u, e)
+            mu_u = self.mu_l * u + (self.mu_a - self.mu_l) * ua[:, None] * e  # M u
+            s = np.sqrt(np.einsum("pi,pi->p", u, u) + self.vs * self.vs)
+            out[self.nodes, :2] = -(n_force / s)[:, None] * mu_u
+        return out
+
+    def derivatives(self, X: np.ndarray, V: np.ndarray | None = None):
+        """-∂F/∂q and -∂F/∂v as (p, 3, 3) blocks at the contact nodes (the residual holds -F).
+        The line direction ê is held fixed (its derivative is left out of the iteration
+        matrix, which only has to be good)."""
+        p = self.nodes.size
+        kq = np.zeros((p, 3, 3))
+        kv = np.zeros((p, 3, 3))
+        delta = self.zb - X[self.nodes, 2]
+        on = delta > 0.0
+        ak = np.where(on, self.area * self.k, 0.0)
+        kq[:, 2, 2] = ak  # F_z = a k (z_b - z): -∂F_z/∂z = a k
+        if V is not None and self.c:
+            kv[:, 2, 2] = np.where(on, self.area * self.c, 0.0)
+        if V is not None and self.friction and on.any():
+            u = V[self.nodes, :2]
+            e = self._direction(X)
+            ua = np.einsum("pi,pi->p", u, e)
+            mu_u = self.mu_l * u + (self.mu_a - self.mu_l) * ua[:, None] * e
+            s = np.sqrt(np.einsum("pi,pi->p", u, u) + self.vs * self.vs)
+            n_force = ak * delta
+            # F_h = -N M u / s, N = a k δ: -∂F_h/∂z = -a k M u / s
+            kq[:, :2, 2] = -(ak / s)[:, None] * mu_u
+            mm = (self.mu_l * np.eye(2)[None]
+                  + (self.mu_a - self.mu_l) * e[:, :, None] * e[:, None, :])  # (p, 2, 2)
+            kv[:, :2, :2] = (n_force / s)[:, None, None] * (
+                mm - mu_u[:, :, None] * u[:, None, :] / (s * s)[:, None, None])
+        return kq, kv
+
+    def energy(self, X: np.ndarray) -> float:
+        """Elastic energy of the contact springs, Σ ½ a k δ², J."""
+        delta = np.maximum(self.zb - X[self.nodes, 2], 0.0)
+        return float(0.5 * np.sum(self.area * self.k * delta * delta))
+
+    def dissipation(self, X: np.ndarray, V: np.ndarray) -> float:
+        """Power taken out of the motion by the seabed's damping and friction, W (>= 0)."""
+        f = self.forces(X, V)
+        fel = np.zeros_like(X)
+        delta = self.zb - X[self.nodes, 2]
+        fel[self.nodes, 2] = np.where(delta > 0, self.area * self.k * delta, 0.0)
+        return float(-np.sum((f - fel) * V))
+
+    def block_slots(self, pattern) -> np.ndarray:
+        """Positions in the CSR data of ``pattern`` of the 3×3 block of every contact node,
+        (p, 3, 3) int (the element blocks hold every node's own 3×3 block)."""
+        d = 3 * self.nodes[:, None] + np.arange(3)[None]  # (p, 3)
+        rows = np.repeat(d[:, :, None], 3, axis=2)
+        cols = np.repeat(d[:, None, :], 3, axis=1)
+        out = np.empty(rows.shape, np.int64)
+        for idx in np.ndindex(rows.shape):
+            r, c = rows[idx], cols[idx]
+            lo, hi = pattern.indptr[r], pattern.indptr[r + 1]
+            k = lo + int(np.searchsorted(pattern.indices[lo:hi], c))
+            out[idx] = k
+        return out
+
+
+@dataclass(frozen=True)
+class ContactState(ElementState):
+    """An element state that also carries the node positions (the contact forces need them)."""
+
+    X: np.ndarray | None = None  # (n_nodes, 3) m
+
+
+class ContactModel(Model):
+    """``model`` with the seabed's penalty contact (no velocity: static and modal steps) in its
+    internal force and tangent stiffness."""
+
+    def __init__(self, model: Model, contact: SeabedContact):
+        self.__dict__.update(model.__dict__)
+        self.base = model
+        self.contact = contact
+        self._slots = contact.block_slots(model.pattern)
+
+    def element_state(self, X: np.ndarray, h0: np.ndarray | None = None) -> ContactState:
+        st = self.base.element_state(X, h0)
+        return ContactState(st.h, st.F, st.K, st.iterations, st.status, np.array(X))
+
+    def internal_force(self, state) -> np.ndarray:
+        return self.base.internal_force(state) - self.contact.forces(state.X).ravel()
+
+    def stiffness_data(self, state) -> np.ndarray:
+        data = self.base.stiffness_data(state)
+        kq, _ = self.contact.derivatives(state.X)
+        np.add.at(data, self._slots.ravel(), kq.ravel())
+        return data
+
+    def stiffness(self, state):
+        return self.pattern.matrix(self.stiffness_data(state))
+
+    def summary(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        """Per cable, at node resolution: unstrained length resting on the seabed (elements
+        with both nodes in contact, half of those with one) and the touchdown point (the last
+        node in contact before the cable leaves the seabed, from its first end)."""
+        mesh = self.mesh
+        nc = len(mesh.cable_names)
+        on = np.zeros(mesh.n_nodes, bool)
+        on[self.contact.nodes] = X[self.contact.nodes, 2] < self.contact.zb
+        on |= self.fixed_mask[:, 2] & (X[:, 2] <= self.contact.zb + 1e-9)
+        n_on = on[mesh.conn].sum(axis=1)
+        length = np.bincount(mesh.cable_of_element, weights=0.5 * n_on * mesh.L0, minlength=nc)
+        touchdown = np.full((nc, 3), np.nan)
+        for ci in range(nc):
+            els = np.flatnonzero(mesh.cable_of_element == ci)
+            for e in els:
+                a, b = mesh.conn[e]
+                if on[a] != on[b] and length[ci] > 0:
+                    touchdown[ci] = X[a] if on[a] else X[b]
+                    break
+        return {"seabed_length": length, "touchdown": touchdown}
