@@ -13,10 +13,11 @@ import math
 
 import numpy as np
 import pytest
-from reference import grounded_catenary
 
 import catdae
 from catdae.case import load_case
+
+from reference import grounded_catenary
 
 EA = 1.674e9
 MASS = 390.0

@@ -8,10 +8,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from reference import grounded_catenary
 
 from catdae.element import grounded as g
 from catdae.model.seabed import SeabedContact
+
+from reference import grounded_catenary
 
 W, EA, L0 = 3324.4, 1.674e9, 76.0
 
