@@ -189,7 +189,7 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
     return results.static_dataset(
-        model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t),
+        model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t, sol.X),
         {"iterations": sol.iterations, "residual_norm": sol.residual_norm,
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),

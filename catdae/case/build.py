@@ -17,9 +17,11 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_fluid import _FluidPass
 from catdae.case.build_seabed import _SeabedPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
+from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
 from catdae.case.limits import size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
@@ -39,7 +41,7 @@ from catdae.case.schema import (
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass, _SeabedPass):
+class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _SeabedPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -108,7 +110,11 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _SeabedPass):
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         steps = self.steps(top.steps)
-        seabed = self.seabed(top.seabed, nodes, supports, materials, steps)
+        water, air = self.water(top.water), self.air(top.air)
+        self.fluid_lines(top.materials, water, air)
+        seabed = self.seabed(top.seabed, nodes, supports, materials, steps,
+                             water_floor=None if water is None or not math.isfinite(water.depth)
+                             else water.surface - water.depth)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -121,7 +127,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _SeabedPass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), seabed=seabed, path=self.path, text=text, name=name,
+            steps=tuple(steps), water=water, air=air, seabed=seabed, path=self.path,
+            text=text, name=name,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -187,7 +194,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _SeabedPass):
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
-                                    float(m.thermal_expansion))
+                                    float(m.thermal_expansion), **line_fluid(m))
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:

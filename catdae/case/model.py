@@ -12,6 +12,7 @@ from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
+from catdae.case.fluid import Air, Water
 from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
 from catdae.case.messages import _found, _is_number
 from catdae.case.timefunc import TimeFunction
@@ -64,6 +65,9 @@ class Material:
     N per metre of unstrained cable (default ``mass * gravity``); ``damping`` material damping per
     unstrained length, N s/m² (>= 0, used by ``damping = { kind = "material" }``);
     ``thermal_expansion`` α in 1/K: a temperature change ΔT adds the strain α ΔT.
+    In water or air (docs/theory.md §13): ``diameter`` d, m (0: the line feels no fluid), the
+    drag coefficients ``drag_normal`` and ``drag_axial`` and the added-mass coefficients
+    ``added_mass_normal`` and ``added_mass_axial`` (MoorDyn's Cd, CdAx, Ca, CaAx).
     """
 
     name: str
@@ -72,6 +76,11 @@ class Material:
     weight: float
     damping: float = 0.0
     thermal_expansion: float = 0.0
+    diameter: float = 0.0
+    drag_normal: float = 0.0
+    drag_axial: float = 0.0
+    added_mass_normal: float = 0.0
+    added_mass_axial: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -244,7 +253,7 @@ class Seabed:
     """A flat seabed at height ``z`` (m, along "up" = -gravity). ``stiffness`` Pa/m (None:
     rigid, static steps only) and ``damping`` Pa s/m act per unit contact area (diameter ×
     unstrained length); Coulomb ``friction_axial``/``friction_lateral`` coefficients, smoothed
-    below ``friction_velocity`` (m/s). docs/theory.md §13."""
+    below ``friction_velocity`` (m/s). docs/theory.md §14."""
 
     z: float
     stiffness: float | None = None
@@ -260,7 +269,8 @@ class Case:
 
     ``nodes`` maps names to ``(x, y, z)`` in m; ``supports`` maps node names to their fixed axes
     (a subset of ``AXES`` in x, y, z order); ``gravity`` in m/s² acts along the unit vector
-    ``gravity_direction`` (default -z). ``path`` is the
+    ``gravity_direction`` (default -z); ``water`` and ``air`` the fluids around the cables
+    (``None``: none). ``path`` is the
     case file (``None`` for text), ``text`` its TOML text, ``name`` its stem. Constructing a Case
     directly skips validation; mappings and sequences are frozen either way.
     """
@@ -278,6 +288,8 @@ class Case:
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
     steps: tuple[Step, ...] = ()
+    water: Water | None = None  # docs/case-format.md, "Water and air"
+    air: Air | None = None
     seabed: Seabed | None = None
     path: str | None = None
     text: str = field(default="", repr=False)

@@ -39,6 +39,8 @@ class _Top(BaseModel):
     support_motions: list[TomlTable] = []
     steps: list[TomlTable] = []
     seabed: TomlTable | None = None
+    water: Any = None  # [water] and [air]: checked by build_fluid
+    air: Any = None
 
 
 class _Material(BaseModel):
@@ -48,6 +50,12 @@ class _Material(BaseModel):
     weight: NonNeg | None = None
     damping: NonNeg = 0.0
     thermal_expansion: float = 0.0
+    # fluid properties of the line (docs/case-format.md, "Water and air")
+    diameter: Pos | None = None
+    drag_normal: NonNeg | None = None
+    drag_axial: NonNeg | None = None
+    added_mass_normal: NonNeg | None = None
+    added_mass_axial: NonNeg | None = None
 
 
 class _Cable(BaseModel):

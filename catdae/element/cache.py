@@ -19,7 +19,7 @@ import hashlib
 from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/mass", "element/residual_kernel",
-                  "element/grounded")
+                  "element/grounded", "element/fluid_kernel")
 _STAMP = "catdae-kernels.sha256"
 
 

@@ -16,6 +16,7 @@ import scipy.sparse as sp
 from catdae.case import Case
 from catdae.case.timefunc import TimeFunction
 from catdae.element.elements import Elements, ElementState, PointLoads
+from catdae.model.fluid import Fluid
 from catdae.model.loading import (  # noqa: F401  (re-exported)
     Loading,
     build_loading,
@@ -126,6 +127,8 @@ class Model:
         self.gauss_s, self.gauss_w = mesh.gauss()
         self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
                                 + ld.mass_value.sum())
+        # water and air (docs/theory.md §13); None for a scene without them
+        self.fluid = Fluid.of(case, mesh, self.lumped_fraction, self.gauss_s, self.gauss_w)
 
     # -------------------------------------------------------------------------------- loads
     def set_time(self, t: float) -> None:
@@ -162,6 +165,7 @@ class Model:
         funcs = [tf for _, tf in self.motions]
         funcs += [tf for tf, _ in self.loading.node_timed]
         funcs += [tf for tf, _ in self.loading.internal_timed]
+        funcs += self.fluid.time_functions() if self.fluid is not None else []
         times = sorted({float(b) for tf in funcs for b in tf.breakpoints()})
         groups: list[list[float]] = []
         for b in times:
@@ -339,13 +343,16 @@ class Model:
         return self.pattern.matrix(self.mass_data(state))
 
     # ------------------------------------------------------------------------- reporting
-    def reactions(self, state: ElementState, t: float) -> np.ndarray:
+    def reactions(self, state: ElementState, t: float, X: np.ndarray | None = None
+                  ) -> np.ndarray:
         """Force the supports exert on the cable, (n_nodes, 3) N; NaN on free axes.
 
         Node equilibrium: support force + external load = Σ resisting forces. Inertia of point
         masses sitting on a support node is not included (the support carries it directly).
         """
         r = self.internal_force(state) - self.nodal_load(t)
+        if self.fluid is not None and X is not None:  # the fluid on the support nodes
+            r += self.fluid.static(X)[0]
         out = np.full(self.n_dof, np.nan)
         out[self.fixed] = r[self.fixed]
         return out.reshape(-1, 3)

@@ -20,6 +20,7 @@ import numpy as np
 from catdae.case import Case
 from catdae.element.elements import SLACK, Elements, PointLoads
 from catdae.errors import CaseError
+from catdae.model.fluid import line_weight
 
 AXES = ("x", "y", "z")
 
@@ -187,7 +188,8 @@ def build_mesh(case: Case) -> Mesh:
         ne = int(cable.elements)
         le = cable.length / ne
         s_nodes = le * np.arange(1, ne)
-        pts = _catenary_points(case, cable, a, b, mat.EA, mat.weight, s_nodes)
+        wc = line_weight(case, cable)  # the submerged weight of a cable wholly in water
+        pts = _catenary_points(case, cable, a, b, mat.EA, wc, s_nodes)
         ids = [add(cable.ends[0], a, ci, 0.0)]
         for k in range(1, ne):
             ids.append(add(f"{cable.name}.{k}", pts[k - 1], ci, float(s_nodes[k - 1])))
@@ -198,7 +200,7 @@ def build_mesh(case: Case) -> Mesh:
             names.append(f"{cable.name}.{k + 1}")
             L0.append(le)
             EA.append(mat.EA)
-            w.append(mat.weight)
+            w.append(wc)
             m.append(mat.mass)
             c.append(mat.damping)
             gp.append(int(cable.gauss_points))

@@ -1,4 +1,4 @@
-"""The seabed in a step's model (docs/theory.md §13).
+"""The seabed in a step's model (docs/theory.md §14).
 
 Two descriptions of one flat bottom at height z_b:
 
@@ -35,7 +35,7 @@ class GroundedState(ElementState):
     @property
     def stiffness6(self) -> np.ndarray:
         """∂(r_i, r_j)/∂(u_i, u_j) = [[P_i K, -P_i K], [-P_j K, P_j K]], P = diag(1, 1, slope):
-        the end forces of a lying end have no vertical part (docs/theory.md §13.3)."""
+        the end forces of a lying end have no vertical part (docs/theory.md §14.3)."""
         k = self.K
         p0 = np.ones((k.shape[0], 3, 1))
         p1 = np.ones((k.shape[0], 3, 1))
@@ -161,16 +161,18 @@ class GroundedModel(Model):
         slope[m == g.LYING] = 0.0
         return GroundedState(h, F, K, its, stat, self.mode, slope)
 
-    def reactions(self, state, t: float) -> np.ndarray:
+    def reactions(self, state, t: float, X: np.ndarray | None = None) -> np.ndarray:
         """Force of the supports on the cable (the seabed's point forces are not reactions)."""
         r = self.internal_force(state) - self.nodal_load(t)
+        if self.fluid is not None and X is not None:
+            r += self.fluid.static(X)[0]
         out = np.full(self.n_dof, np.nan)
         out[self.base.fixed] = r[self.base.fixed]
         return out.reshape(-1, 3)
 
 
 class SeabedContact:
-    """Penalty contact of the free nodes with the seabed (docs/theory.md §13.5).
+    """Penalty contact of the free nodes with the seabed (docs/theory.md §14.5).
 
     Node k has the contact area a_k = Σ_e ½ L0_e d_e of its elements (d the contact width,
     the materials' ``diameter``). Below the seabed (δ = z_b - z > 0) the seabed pushes it up

@@ -34,7 +34,10 @@ def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) 
     """The n_modes lowest modes of the model linearised about positions X and element state."""
     free = model.free
     k = model.stiffness(state)[free][:, free]
-    m = model.mass(state)[free][:, free]
+    m = model.mass(state)
+    if model.fluid is not None:  # the added mass of the water (docs/theory.md §13)
+        m = m + model.pattern.matrix(model.pattern.assemble(model.fluid.mass(X)))
+    m = m[free][:, free]
     nf = free.size
     n_modes = min(int(n_modes), nf)
     if n_modes < 1:

@@ -199,6 +199,8 @@ class TransientProblem:
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = (t, np.array(y[0::2], copy=True))
+        if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
+            res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
         return True
 
     def _conf_from_buffers(self):
@@ -273,6 +275,8 @@ class TransientProblem:
         out += self.m_diag * A - m.nodal_load(t)
         if damped:
             out += (self.c_diag + self.alpha * self.m_diag) * V
+        if m.fluid is not None:
+            out += m.fluid.evaluate(t, self._conf_X(), V, A)[0]
         return out
 
     def blocks(self, conf, cj, V=None, A=None):
@@ -307,8 +311,20 @@ class TransientProblem:
         return m.pattern.assemble(k6), m.pattern.assemble(vv, diag)
 
     def mass_data(self, conf) -> np.ndarray:
-        """CSR data (full dofs) of M(q)."""
-        return self.model.pattern.assemble(conf[1], self.m_diag)
+        """CSR data (full dofs) of M(q) (with the added mass of the water, if any)."""
+        m = self.model
+        if m.fluid is not None:
+            z = np.zeros(self.n_dof)
+            ma = m.fluid.evaluate(self._cache_t, self._conf_X(), z, z)[1]
+            return m.pattern.assemble(conf[1], self.m_diag) + m.pattern.assemble(ma)
+        return m.pattern.assemble(conf[1], self.m_diag)
+
+    def _conf_X(self) -> np.ndarray:
+        """Node positions (n_dof,) of the configuration last returned by ``configuration``."""
+        X = self.X.copy()
+        X[self.fidx] = self._cache_q
+        X[self.model.fixed] = self._supports(self._cache_t)[0]
+        return X
 
     def ff(self, data: np.ndarray) -> sp.csr_matrix:
         """Free-free block (in the unknowns' order) of full-dof CSR data."""
@@ -333,6 +349,13 @@ class TransientProblem:
         if conf[3] is not None:
             V, A = self.full_vectors(t, y[1::2], yp[1::2])
         kdata, vdata = self.blocks(conf, cj, V, A)
+        fl = self.model.fluid
+        if fl is not None:  # docs/theory.md §13: ∂(M_a a - f)/∂q and cj M_a - ∂f/∂v
+            V, A = self.full_vectors(t, y[1::2], yp[1::2])
+            _, ma, kx, kv = fl.evaluate(t, self._conf_X(), V, A, want_jac=True)
+            pat = self.model.pattern
+            kdata = kdata + pat.assemble(kx)
+            vdata = vdata + pat.assemble(cj * ma + kv)
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
@@ -431,6 +454,8 @@ class TransientProblem:
         X, V, A = self._Xb.copy(), self._Vb.copy(), self._Ab.copy()
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         f = self._force + self.m_diag * A + self._v_diag * V - p  # M A + C V + g + F - P
+        if m.fluid is not None:
+            f += m.fluid.out  # M_a A - f_fluid, left by evaluate
         reaction = np.full(self.n_dof, np.nan)
         reaction[m.fixed] = f[m.fixed]
         kinetic = 0.5 * float(self.m_diag @ (V * V))

@@ -1,4 +1,4 @@
-"""Static equilibrium on a rigid, frictionless seabed (docs/theory.md §13.4).
+"""Static equilibrium on a rigid, frictionless seabed (docs/theory.md §14.4).
 
 The nodes resting on the seabed are an active set: they are held at z_b (a roller in z) and
 the elements with an end on the seabed take their grounded relations (catdae.model.seabed,

@@ -30,8 +30,18 @@ class StaticSolution:
     load_steps: int  # load increments used
 
 
-def _residual(model: Model, state: ElementState, p: np.ndarray) -> np.ndarray:
-    return (model.internal_force(state) - p)[model.free]
+def _residual(model: Model, state: ElementState, p: np.ndarray, X: np.ndarray) -> np.ndarray:
+    r = model.internal_force(state) - p
+    if model.fluid is not None:  # buoyancy, steady current and wind drag (theory §13)
+        r += model.fluid.static(X)[0]
+    return r[model.free]
+
+
+def _stiffness(model: Model, state: ElementState, X: np.ndarray):
+    if model.fluid is None:
+        return model.stiffness(state)
+    return model.pattern.matrix(model.stiffness_data(state)
+                                + model.pattern.assemble(model.fluid.static(X)[1]))
 
 
 def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: float = 0.0,
@@ -40,6 +50,8 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
     X = np.array(X, float, copy=True)
     X.reshape(-1)[model.fixed] = model.support_positions(t)
     model.set_time(t)
+    if model.fluid is not None:
+        model.fluid.t = t
     p_full = model.nodal_load(t)
     f_full = model.elements.loads.f.copy()
     state = model.element_state(X, h0)
@@ -74,14 +86,14 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
             raise ConvergenceError(
                 f"static equilibrium not found: load factor stuck at {lam:.6g} "
                 f"(|R| = {rnorm:.3g} N after {total_iter} Newton iterations)")
-    r = _residual(model, state, p_full)
+    r = _residual(model, state, p_full, X)
     return StaticSolution(X, state, total_iter, float(np.abs(r).max(initial=0.0)), n_inc)
 
 
 def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
     """Damped Newton at a fixed load. Returns (ok, X, state, iterations, |R|)."""
     free = model.free
-    r = _residual(model, state, p)
+    r = _residual(model, state, p, X)
     rn = np.linalg.norm(r)
     if free.size == 0:
         return True, X, state, 0, rn
@@ -89,7 +101,7 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
         tscale = max(fscale, float(np.abs(state.h).max(initial=0.0)))
         if rn <= rtol * tscale:
             return True, X, state, it - 1, rn
-        k = model.stiffness(state)[free][:, free].tocsc()
+        k = _stiffness(model, state, X)[free][:, free].tocsc()
         dx = _solve(k, -r)
         if dx is None:
             return False, X, state, it, rn
@@ -126,7 +138,7 @@ def _line_search(model: Model, X, state, dx, r, rn, p):
         st = model.element_state(Xt, state.h)
         if (st.status == NOT_CONVERGED).any():
             return None
-        rt = _residual(model, st, p)
+        rt = _residual(model, st, p, Xt)
         if not np.all(np.isfinite(rt)):
             return None
         return Xt, st, rt

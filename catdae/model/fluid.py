@@ -1,0 +1,251 @@
+"""The water and air around the cables of a step (docs/theory.md §13): the line's fluid
+properties per element, the current, waves and wind, and the compiled Morison pass
+(``catdae.element.fluid_kernel``) that turns them into nodal forces, added mass and their
+derivatives. A scene without ``[water]`` and ``[air]`` has no :class:`Fluid` at all
+(``Model.fluid is None``) and pays nothing.
+
+Buoyancy is exact in statics where it can be: a cable that lies wholly below the still-water
+level (both ends below it, and heavier than the water it displaces) carries its submerged
+weight w - ρ g π d²/4 in the element itself (:func:`line_weight`, used by the mesh), so its
+static nodes are those of the elastic catenary of the submerged weight. Other cables get their
+buoyancy at the Gauss points below the instantaneous surface, and points of a submerged cable
+that a wave trough leaves in air lose theirs there.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from catdae.case import Case
+from catdae.case.fluid import Waves
+from catdae.case.timefunc import Ramp
+from catdae.element.fluid_kernel import (
+    LOG,
+    NONE,
+    POWER,
+    PROFILE,
+    UNIFORM,
+    fluid_pass,
+    point_kinematics,
+)
+
+_EMPTY = np.zeros(0)
+
+
+def line_weight(case: Case, cable) -> float:
+    """Weight per unstrained metre that the elements of ``cable`` carry (N/m): the material's,
+    less the buoyancy ρ g π d²/4 when the cable lies wholly in still water
+    (:func:`buoyancy_in_weight`)."""
+    mat = case.material_of(cable)
+    if not buoyancy_in_weight(case, cable):
+        return mat.weight
+    return mat.weight - case.water.density * case.gravity * _area(mat.diameter)
+
+
+def buoyancy_in_weight(case: Case, cable) -> bool:
+    """Whether a cable's buoyancy is held in its element weight: water, a diameter, both ends
+    at or below the still-water level and a submerged weight >= 0 (the catenary then hangs
+    below its chord, so wholly under water)."""
+    water = case.water
+    mat = case.material_of(cable)
+    if water is None or mat.diameter <= 0.0:
+        return False
+    ends = [case.nodes[n][2] for n in cable.ends]
+    wsub = mat.weight - water.density * case.gravity * _area(mat.diameter)
+    return max(ends) <= water.surface and wsub >= 0.0
+
+
+def _area(d: float) -> float:
+    return math.pi * d * d / 4.0
+
+
+def dispersion(omega: float, g: float, depth: float) -> float:
+    """Wave number k (1/m) of ω² = g k tanh(k depth) (deep water: k = ω²/g)."""
+    k = omega * omega / g
+    if math.isinf(depth):
+        return k
+    k = max(k, omega / math.sqrt(g * depth))  # shallow-water start, below the root
+    for _ in range(100):
+        th = math.tanh(k * depth)
+        f = g * k * th - omega * omega
+        df = g * th + g * k * depth * (1.0 - th * th)
+        dk = f / df
+        k -= dk
+        if abs(dk) <= 1e-15 * k:
+            break
+    return k
+
+
+def wave_components(waves: Waves, g: float, depth: float) -> tuple[np.ndarray, ...]:
+    """(amplitude m, ω rad/s, k 1/m, cos heading, sin heading, phase rad) of every component.
+
+    JONSWAP: ``components`` frequencies, one drawn at random in each of equal bins of
+    [ωp/2, 3 ωp] (so the record does not repeat), amplitudes sqrt(2 S(ω) Δω) scaled so that
+    4 (Σ a²/2)^½ = hs exactly, phases uniform in [0, 2π); ``seed`` fixes both draws.
+    """
+    b = math.radians(waves.heading)
+    if waves.kind == "airy":
+        om = np.array([2.0 * math.pi / waves.period])
+        amp = np.array([0.5 * waves.height])
+        ph = np.array([math.radians(waves.phase)])
+    else:
+        rng = np.random.default_rng(waves.seed)
+        wp = 2.0 * math.pi / waves.tp
+        n = int(waves.components)
+        edges = np.linspace(0.5 * wp, 3.0 * wp, n + 1)
+        dw = edges[1] - edges[0]
+        om = edges[:-1] + dw * rng.random(n)
+        sigma = np.where(om <= wp, 0.07, 0.09)
+        r = np.exp(-((om - wp) ** 2) / (2.0 * sigma**2 * wp**2))
+        s = om**-5.0 * np.exp(-1.25 * (wp / om) ** 4) * waves.gamma**r
+        amp = np.sqrt(2.0 * s * dw)
+        amp *= waves.hs / (4.0 * math.sqrt(0.5 * float(amp @ amp)))
+        ph = 2.0 * math.pi * rng.random(n)
+    k = np.array([dispersion(float(w), g, depth) for w in om])
+    n = om.size
+    return amp, om, k, np.full(n, math.cos(b)), np.full(n, math.sin(b)), ph
+
+
+class Fluid:
+    """The fluids of one step and the per-element line properties the Morison pass reads."""
+
+    def __init__(self, case: Case, mesh, lumped_fraction: float, gauss_s, gauss_w):
+        ne = mesh.n_elements
+        self.g = case.gravity
+        self.mu = float(lumped_fraction)
+        self.conn = np.ascontiguousarray(mesh.conn, np.int64)
+        self.l0 = mesh.L0
+        self.gs, self.gw = gauss_s, gauss_w
+        mats = [case.material_of(c) for c in case.cables]
+        in_w = [buoyancy_in_weight(case, c) for c in case.cables]
+        ce = mesh.cable_of_element
+
+        def per(f):
+            return np.ascontiguousarray([f(mats[k]) for k in ce], float).reshape(ne)
+
+        self.diam = per(lambda m: m.diameter)
+        self.area = np.pi * self.diam**2 / 4.0
+        self.cdn = per(lambda m: m.drag_normal)
+        self.cda = per(lambda m: m.drag_axial)
+        self.can = per(lambda m: m.added_mass_normal)
+        self.caa = per(lambda m: m.added_mass_axial)
+        self.in_weight = np.array([1.0 if in_w[k] else 0.0 for k in ce]).reshape(ne)
+        water, air = case.water, case.air
+        self.water, self.air = water, air
+        self.rho_w = water.density if water is not None else 0.0
+        self.surface = water.surface if water is not None else 0.0
+        self.depth = water.depth if water is not None else math.inf
+        cur = water.current if water is not None else None
+        self.c_time = cur.time if cur is not None else None
+        if cur is None:
+            self.c_kind, self.c_vec, self.c_z, self.c_v = NONE, np.zeros(3), _EMPTY, \
+                np.zeros((0, 3))
+        elif not cur.z:
+            self.c_kind, self.c_vec = UNIFORM, np.array(cur.velocity[0], float)
+            self.c_z, self.c_v = _EMPTY, np.zeros((0, 3))
+        else:
+            self.c_kind, self.c_vec = PROFILE, np.zeros(3)
+            self.c_z = np.array(cur.z, float)
+            self.c_v = np.ascontiguousarray(cur.velocity, float).reshape(-1, 3)
+        waves = water.waves if water is not None else None
+        self.waves = waves
+        self.wave = (wave_components(waves, self.g, self.depth) if waves is not None
+                     else (_EMPTY,) * 6)
+        # the waves rise over ``ramp`` s as the quintic smoothstep (C2: no restart needed)
+        self._ramp = (Ramp(waves.ramp, smooth=True) if waves is not None and waves.ramp > 0
+                      else None)
+        self.rho_a = air.density if air is not None else 0.0
+        wind = air.wind if air is not None else None
+        self.a_time = wind.time if wind is not None else None
+        self.a_vec = np.zeros(3)
+        self.a_speed, self.a_dir = 0.0, np.zeros(3)
+        self.a_expo, self.a_zref, self.a_ground = 0.0, 10.0, 0.0
+        self.a_kind = NONE
+        if wind is not None:
+            vec = np.array(wind.vector, float)
+            self.a_kind = {"uniform": UNIFORM, "power": POWER, "log": LOG}[wind.profile]
+            self.a_vec = vec
+            self.a_speed = float(np.linalg.norm(vec))
+            self.a_dir = vec / self.a_speed if self.a_speed > 0 else np.zeros(3)
+            self.a_expo, self.a_zref = wind.parameter, wind.reference_height
+            self.a_ground = (wind.ground if wind.ground is not None else
+                             self.surface if water is not None else 0.0)
+        self.t = 0.0  # time of a static or modal step
+        self._static_key = None
+        self._static = None
+        nd = 3 * mesh.n_nodes
+        self.out = np.zeros(nd)
+        self.ma = np.zeros((ne, 6, 6))
+        self.kx = np.zeros((ne, 6, 6))
+        self.kv = np.zeros((ne, 6, 6))
+
+    @classmethod
+    def of(cls, case: Case, mesh, lumped_fraction, gauss_s, gauss_w) -> Fluid | None:
+        """The fluid of a scene, or None when it has neither water nor air."""
+        if case.water is None and case.air is None:
+            return None
+        return cls(case, mesh, lumped_fraction, gauss_s, gauss_w)
+
+    # ---------------------------------------------------------------------------- time
+    def _factors(self, t: float, waves: bool):
+        cf = 1.0 if self.c_time is None else float(self.c_time.evaluate(t)[0])
+        af = 1.0 if self.a_time is None else float(self.a_time.evaluate(t)[0])
+        r, dr = 1.0, 0.0
+        if waves and self._ramp is not None:
+            r, dr = (float(x) for x in self._ramp.evaluate(t)[:2])
+        return cf, af, r, dr
+
+    def time_functions(self) -> list:
+        """The time functions of the current and wind, whose kinks and jumps restart a
+        transient (the wave ramp is C2 and has none)."""
+        return [tf for tf in (self.c_time, self.a_time) if tf is not None]
+
+    # ---------------------------------------------------------------------------- the pass
+    def evaluate(self, t: float, X, V, A, want_jac: bool = False, waves: bool = True):
+        """Run the pass: ``out`` (n_dof,) = M_a A - f_fluid, ``ma``, ``kx``, ``kv`` (n_elem,
+        6, 6) (docs/theory.md §13); the arrays are the Fluid's own buffers."""
+        cf, af, r, dr = self._factors(t, waves)
+        wave = self.wave if waves else (_EMPTY,) * 6
+        fluid_pass(np.ascontiguousarray(X, float).reshape(-1),
+                   np.ascontiguousarray(V, float).reshape(-1),
+                   np.ascontiguousarray(A, float).reshape(-1), self.conn, self.l0, self.gs,
+                   self.gw, self.area, self.diam, self.cdn, self.cda, self.can, self.caa,
+                   self.in_weight, self.mu, self.g, self.rho_w, self.surface, self.depth,
+                   self.c_kind, self.c_vec, self.c_z, self.c_v, cf, *wave, r, dr,
+                   self.rho_a, self.a_kind, self.a_vec, self.a_speed, self.a_dir, self.a_expo,
+                   self.a_zref, self.a_ground, af, float(t), want_jac, self.out, self.ma,
+                   self.kx, self.kv)
+        return self.out, self.ma, self.kx, self.kv
+
+    def static(self, X):
+        """(-f (n_dof,), -∂f/∂X (n_elem, 6, 6)) of the fluid on the line at rest in still
+        water at the static time ``self.t`` (buoyancy, steady current and wind drag; no
+        waves). The last result is kept for the positions it was computed at."""
+        X = np.asarray(X, float).reshape(-1)
+        key = (self.t, X.tobytes())
+        if self._static_key != key:
+            z = np.zeros(X.size)
+            out, _, kx, _ = self.evaluate(self.t, X, z, z, want_jac=True, waves=False)
+            self._static = (out.copy(), kx.copy())
+            self._static_key = key
+        return self._static
+
+    def mass(self, X, t: float = 0.0) -> np.ndarray:
+        """Element added-mass matrices (n_elem, 6, 6) about positions X (still water)."""
+        z = np.zeros(np.size(X))
+        return self.evaluate(t, X, z, z, waves=False)[1]
+
+    def kinematics(self, points: np.ndarray, t: float):
+        """Surface elevation above the still level at the points' (x, y), (n,) m, and the fluid
+        velocity at the points (water below the surface, air above), (n, 3) m/s."""
+        cf, af, r, dr = self._factors(t, True)
+        pts = np.ascontiguousarray(points, float).reshape(-1, 3)
+        eta = np.zeros(pts.shape[0])
+        vel = np.zeros((pts.shape[0], 3))
+        point_kinematics(pts, float(t), self.rho_w, self.surface, self.depth, self.c_kind,
+                         self.c_vec, self.c_z, self.c_v, cf, *self.wave, r, dr, self.rho_a,
+                         self.a_kind, self.a_vec, self.a_speed, self.a_dir, self.a_expo,
+                         self.a_zref, self.a_ground, af, eta, vel)
+        return eta, vel
