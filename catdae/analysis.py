@@ -198,6 +198,10 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     model.set_time(state.t)
+    if model.case.seabed is not None:  # the seabed's contact springs (docs/theory.md §14)
+        from catdae.model.seabed import ContactModel
+
+        model = ContactModel.of(model)
     est = model.element_state(state.X, state.h)
     if (est.status == NOT_CONVERGED).any():
         raise ConvergenceError(f"modal step '{step.name}': an element cannot be solved in the "

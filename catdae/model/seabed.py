@@ -218,6 +218,15 @@ class SeabedContact:
         np.add.at(area, mesh.conn.ravel(), np.repeat(0.5 * mesh.L0 * width, 2))
         return cls(model.case.seabed, mesh, ~model.fixed_mask[:, 2], area, stiffness)
 
+    @classmethod
+    def of_step(cls, model: Model) -> SeabedContact | None:
+        """The contact of a modal or transient step: None without a seabed (a rigid one is
+        for static steps only, the case validation says so)."""
+        sb = model.case.seabed
+        if sb is None or sb.stiffness is None:
+            return None
+        return cls.of_model(model)
+
     def _direction(self, X):
         d = X[self.nb_b, :2] - X[self.nb_a, :2]
         n = np.hypot(d[:, 0], d[:, 1])
@@ -316,6 +325,11 @@ class ContactModel(Model):
         self.base = model
         self.contact = contact
         self._slots = contact.block_slots(model.pattern)
+
+    @classmethod
+    def of(cls, model: Model) -> ContactModel:
+        """``model`` with the penalty contact of its case's seabed."""
+        return cls(model, SeabedContact.of_model(model))
 
     def element_state(self, X: np.ndarray, h0: np.ndarray | None = None) -> ContactState:
         st = self.base.element_state(X, h0)

@@ -48,6 +48,7 @@ from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.seabed import SeabedContact
 from catdae.output.transient import potential
 
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
@@ -132,6 +133,10 @@ class TransientProblem:
         self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
         self._fast_setup()
+        # the seabed's penalty contact (docs/theory.md §14); None for a scene without one
+        self.seabed = SeabedContact.of_step(model)
+        if self.seabed is not None:
+            self._seabed_slots = self.seabed.block_slots(model.pattern).ravel()
 
     def _fast_setup(self) -> None:
         """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
@@ -201,6 +206,9 @@ class TransientProblem:
         self._buffers_at = (t, np.array(y[0::2], copy=True))
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
+        if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §14)
+            res[1::2] -= self.seabed.forces(self._Xb.reshape(-1, 3),
+                                            self._Vb.reshape(-1, 3)).ravel()[self._fidx]
         return True
 
     def _conf_from_buffers(self):
@@ -277,6 +285,8 @@ class TransientProblem:
             out += (self.c_diag + self.alpha * self.m_diag) * V
         if m.fluid is not None:
             out += m.fluid.evaluate(t, self._conf_X(), V, A)[0]
+        if self.seabed is not None:
+            out -= self.seabed.forces(self._conf_X().reshape(-1, 3), V.reshape(-1, 3)).ravel()
         return out
 
     def blocks(self, conf, cj, V=None, A=None):
@@ -356,6 +366,13 @@ class TransientProblem:
             pat = self.model.pattern
             kdata = kdata + pat.assemble(kx)
             vdata = vdata + pat.assemble(cj * ma + kv)
+        if self.seabed is not None:  # docs/theory.md §14: -∂f/∂q, -∂f/∂v of the contact
+            V, _ = self.full_vectors(t, y[1::2], yp[1::2])
+            kq, kv = self.seabed.derivatives(self._conf_X().reshape(-1, 3), V.reshape(-1, 3))
+            kdata = kdata.copy()
+            vdata = vdata.copy()
+            np.add.at(kdata, self._seabed_slots, kq.ravel())
+            np.add.at(vdata, self._seabed_slots, kv.ravel())
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
@@ -463,6 +480,8 @@ class TransientProblem:
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        if self.seabed is not None:  # the contact springs' energy (docs/theory.md §14)
+            gravity += self.seabed.energy(X.reshape(-1, 3))
         return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
 
