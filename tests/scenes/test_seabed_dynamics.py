@@ -9,8 +9,6 @@ import math
 
 import numpy as np
 import pytest
-from reference import grounded_catenary
-from repo_paths import CASES
 
 import catdae
 from catdae.case import load_case
@@ -19,6 +17,9 @@ from catdae.model.mesh import build_mesh
 from catdae.model.seabed import ContactModel
 from catdae.solvers.residual import TransientProblem
 from catdae.solvers.static import solve_static
+
+from reference import grounded_catenary
+from repo_paths import CASES
 
 G = 9.81
 
