@@ -109,6 +109,7 @@ def chain_metric(times: np.ndarray, fair_tension: np.ndarray, depth: int, motion
     """MoorDyn's dynamic metric for catdae's fairlead tension (N) sampled at ``times`` (case
     clock, s): max |ΔT - ΔT_ref| / (2 max |ΔT_ref|) over the reference's rows."""
     ref = read_table(DATA / "quasi_static_chain" / f"WD{depth:04d}_Chain_{motion}.txt")
+    ref = ref[ref[:, 0] + 10.0 <= times[-1] + 1e-9]  # rows the run reached
     t_ref = ref[:, 0] + 10.0  # the record starts at -10 s, the case clock at 0
     d_ref = 1e3 * ref[:, 3] - 1e3 * CHAIN[depth][2]
     d_own = np.interp(t_ref, times, fair_tension) - fair_tension[0]

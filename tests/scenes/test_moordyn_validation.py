@@ -45,22 +45,20 @@ def test_jumper_static_end_forces():
 
 
 @pytest.mark.slow
-def test_chain_heave_against_orcaflex_shortened():
-    """The 200 m chain under the 2 m heave record, the first 15 s of the comparison: within
-    MoorDyn's dynamic tolerance 0.15."""
-    tree = _run(chain_toml(200, motion="ZZP1_A1", duration=25.0, elements=20, rtol=1e-3))
+def test_chain_heave_against_orcaflex():
+    """The 200 m chain under the 2 m heave record (20 s compared after 10 s of lead-in), 20
+    elements, rtol 1e-3: within MoorDyn's dynamic tolerance 0.15 (MoorDyn: 0.07-0.12)."""
+    tree = _run(chain_toml(200, motion="ZZP1_A1", elements=20, rtol=1e-3))
     ds = tree["heave"].to_dataset()
     tension = np.linalg.norm(ds.reaction.sel(node="fairlead").values, axis=-1)
-    t0 = np.linalg.norm(tree["static"].to_dataset().reaction.sel(node="fairlead").values)
-    times = np.concatenate([[0.0], ds.time.values])
-    err = chain_metric(times, np.concatenate([[t0], tension]), 200, "ZZP1_A1")
-    assert err <= 0.15
+    assert chain_metric(ds.time.values, tension, 200, "ZZP1_A1") <= 0.15
 
 
 @pytest.mark.slow
-def test_jumper_case3_shortened():
-    """Jumper case 3 (top heave), the first 20 s after the ramp: within 1.5 kN of the paper."""
-    tree = _run(jumper_toml(case=3, duration=47.0, elements=20, rtol=1e-3))
-    ds = tree["case3"].to_dataset()
+def test_jumper_case2_shortened():
+    """Jumper case 2 (top sway along y), the first 30 s after the ramp, 40 elements: within
+    1.5 kN of the paper (MoorDyn with EI = 0: 0.35 kN over the whole case)."""
+    tree = _run(jumper_toml(case=2, duration=57.0, elements=40, rtol=1e-4))
+    ds = tree["case2"].to_dataset()
     tension = np.linalg.norm(ds.reaction.sel(node="top").values, axis=-1)
-    assert jumper_error(ds.time.values, tension, 3) <= 1.5e3
+    assert jumper_error(ds.time.values, tension, 2) <= 1.5e3
