@@ -4,8 +4,9 @@ expected), through ``catdae check`` and ``catdae run`` (tests/unit/test_hostile_
 from __future__ import annotations
 
 import pytest
-from scene_toml import cable_scene, static_step, transient_step
 from test_hostile_cases import invalid
+
+from scene_toml import cable_scene, static_step, transient_step
 
 
 def scene(seabed: str, steps: str | None = None, diameter: bool = True) -> str:
