@@ -177,10 +177,13 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
 
 
 def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
-    if model.case.seabed is not None:
-        from catdae.solvers.seabed_static import static_seabed_step
+    if model.case.seabed is not None:  # docs/theory.md §14
+        from catdae.output.seabed import add_seabed
+        from catdae.solvers.seabed_static import solve_static_on_seabed
 
-        return static_seabed_step(step, model, state, _static_result)
+        sol, model, summary = solve_static_on_seabed(model, state.X, state.h, t=state.t,
+                                                     load_steps=step.load_steps)
+        return add_seabed(_static_result(model, state, sol), model.mesh, summary)
     sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
     return _static_result(model, state, sol)
 

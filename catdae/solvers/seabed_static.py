@@ -158,18 +158,15 @@ def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str,
     return {"seabed_length": length, "touchdown": touchdown}
 
 
-def static_seabed_step(step, model: Model, state, static_result):
-    """A static step of a scene with a seabed: rigid (no ``stiffness``) or penalty contact.
-    ``static_result`` (catdae.analysis) turns (model, state, solution) into the dataset."""
-    from catdae.output.seabed import add_seabed
 
+def solve_static_on_seabed(model: Model, X, h0=None, t: float = 0.0, load_steps: int = 1):
+    """A static step of a scene with a seabed: on the rigid seabed (no ``stiffness``, §14.4)
+    or on its contact springs (§14.5). Returns (solution, the model whose tensions and
+    reactions are the solution's, per-cable seabed_length and touchdown)."""
     sb = model.case.seabed
     if sb.stiffness is None:
-        sol, gm = solve_static_seabed(model, sb.z, state.X, state.h, t=state.t,
-                                      load_steps=step.load_steps)
-        ds = static_result(gm, state, sol)
-        return add_seabed(ds, gm.mesh, seabed_summary(gm, sol.X, sol.state.h))
+        sol, gm = solve_static_seabed(model, sb.z, X, h0, t=t, load_steps=load_steps)
+        return sol, gm, seabed_summary(gm, sol.X, sol.state.h)
     contact = ContactModel(model, SeabedContact.of_model(model))
-    sol = solve_static(contact, state.X, state.h, t=state.t, load_steps=step.load_steps)
-    ds = static_result(contact, state, sol)
-    return add_seabed(ds, model.mesh, contact.summary(sol.X))
+    sol = solve_static(contact, X, h0, t=t, load_steps=load_steps)
+    return sol, contact, contact.summary(sol.X)
