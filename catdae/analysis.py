@@ -23,6 +23,7 @@ from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
 from catdae.output import results
+from catdae.output.transient import as_dataset
 from catdae.solvers.modal import solve_modal
 from catdae.solvers.static import solve_static
 
@@ -86,7 +87,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         except KeyboardInterrupt as exc:
             # keep what the finished steps (and a transient, up to the interrupt) computed;
             # the interrupt itself goes on
-            ds_partial = getattr(exc, "partial", None)
+            ds_partial = as_dataset(getattr(exc, "partial", None))
             status = f"interrupted in step '{step.name}'"
             if isinstance(ds_partial, xr.Dataset):
                 groups[step.name] = rotate_back(ds_partial, rotation)
@@ -94,7 +95,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
             writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
         except CatdaeError as exc:
-            ds_partial = getattr(exc, "partial", None)
+            ds_partial = as_dataset(getattr(exc, "partial", None))
             if isinstance(ds_partial, xr.Dataset):
                 groups[step.name] = rotate_back(ds_partial, rotation)
             status = f"failed in step '{step.name}': {exc}"
@@ -157,7 +158,7 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
         return _modal_step(step, model, state)
     from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 
-    return run_transient(step, model, state, writer, progress)
+    return as_dataset(run_transient(step, model, state, writer, progress))
 
 
 def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _State):
@@ -211,9 +212,9 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                "current configuration")
     sol = solve_modal(model, state.X, est, step.modes)
     return results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
-                                 {"solver": sol.solver, "mass_model": model.mass_model,
-                                  "mass_model_setting": model.mass_model_setting,
-                                  "mass_model_choice": model.mass_model_choice,
+                                 {"solver": sol.solver, "mass_model": model.mass_model.name,
+                                  "mass_model_setting": model.mass_model.setting,
+                                  "mass_model_choice": model.mass_model.choice,
                                   "status": "completed"})
 
 
@@ -272,10 +273,12 @@ class _Writer:
         with deferred():
             results.write_tree(tree, path)
 
-    def write_increment(self, name: str, ds: xr.Dataset) -> None:
-        """A readable snapshot of the run so far, beside the output (never over it)."""
+    def write_increment(self, name: str, ds) -> None:
+        """A readable snapshot of the run so far (a dataset or a transient's output record),
+        beside the output (never over it)."""
         if self.output is None:
             return
+        ds = as_dataset(ds)
         t = f" at t = {float(ds.time[-1]):.6g} s" if ds.sizes.get("time") else ""
         ds = ds.assign_attrs(status=f"running (snapshot{t}; the step has not finished)")
         tree = results.make_tree(self.case, {**self.groups,

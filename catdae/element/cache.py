@@ -18,8 +18,9 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-KERNEL_MODULES = ("element/catenary", "element/mass", "element/residual_kernel",
-                  "element/grounded", "element/fluid_kernel")
+KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
+                  "element/mass_gradient", "element/residual_kernel", "element/grounded",
+                  "element/fluid_kernel")
 _STAMP = "catdae-kernels.sha256"
 
 

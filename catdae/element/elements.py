@@ -16,6 +16,8 @@ from catdae.element.catenary import (  # noqa: F401  (re-exported)
     NOT_CONVERGED,
     SLACK,
     STATUS_NAMES,
+)
+from catdae.element.catenary_batch import (  # noqa: F401  (re-exported)
     _energy_batch,
     _partial_batch,
     _solve_batch,

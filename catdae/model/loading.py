@@ -1,6 +1,6 @@
 """What a step holds (docs/theory.md §4, §7): the point masses, point loads and distributed
-loads present in it, split by where they act (at nodes, inside elements), and the mass model a
-step with ``mass_model = "auto"`` uses for the scene.
+loads present in it, split by where they act (at nodes, inside elements), and the free-hanging
+ends that decide the mass model ``auto`` picks (catdae.model.settings).
 """
 
 from __future__ import annotations
@@ -25,23 +25,6 @@ def free_hanging_ends(case: Case, mesh: Mesh, node_mass: np.ndarray) -> list[str
             supported[mesh.node_index(node)] = True
     tips = (degree == 1) & ~supported & (node_mass <= 0.0)
     return [mesh.node_names[k] for k in np.flatnonzero(tips)]
-
-
-def choose_mass_model(setting: str, kind: str, ends: list[str]) -> tuple[str, str]:
-    """The mass model of a step and why: ``setting`` as given, or for ``"auto"`` (the default,
-    docs/case-format.md, mass_model) "blended", except with a free-hanging end (``ends``, from
-    :func:`free_hanging_ends`): "consistent" for a modal step (the blend's lumped half puts
-    mass on the tip, which has no lateral stiffness, and adds a spurious mode), "lumped" for a
-    transient step (the consistent part breaks causality and the work-energy balance there;
-    tests/scenes/test_extremes.py measures both). Returns (model, choice)."""
-    if setting != "auto":
-        return setting, "set by the step"
-    if not ends:
-        return "blended", "auto: blended (no free-hanging end)"
-    shown = ", ".join(ends[:3]) + (f" and {len(ends) - 3} more" if len(ends) > 3 else "")
-    chosen = "consistent" if kind == "modal" else "lumped"
-    return chosen, f"auto: {chosen} (free-hanging end at {shown})"
-
 
 
 @dataclass

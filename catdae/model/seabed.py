@@ -225,7 +225,18 @@ class SeabedContact:
         sb = model.case.seabed
         if sb is None or sb.stiffness is None:
             return None
-        return cls.of_model(model)
+        out = cls.of_model(model)
+        out.slots = out.block_slots(model.pattern).ravel()
+        return out
+
+    def add_derivatives(self, kdata, vdata, X, V):
+        """CSR data (``slots`` of the step's pattern) of ∂r/∂q and ∂r/∂v with the contact's
+        -∂f/∂q and -∂f/∂v added (copies)."""
+        kq, kv = self.derivatives(X.reshape(-1, 3), V.reshape(-1, 3))
+        kdata, vdata = kdata.copy(), vdata.copy()
+        np.add.at(kdata, self.slots, kq.ravel())
+        np.add.at(vdata, self.slots, kv.ravel())
+        return kdata, vdata
 
     def _direction(self, X):
         d = X[self.nb_b, :2] - X[self.nb_a, :2]

@@ -1,84 +1,28 @@
-"""The results of a transient step: output arrays filled at the output times, energies, the
-dataset, and the run's own advice on its accuracy (docs/theory.md §8, §10)."""
+"""The dataset of a transient step from its output record (catdae.solvers.record)."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from catdae._xr import xr
-from catdae.model.assembly import Model
 from catdae.output import results
 
-_GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
+
+def dataset(rec) -> xr.Dataset:
+    """Histories of the first ``rec.n_valid`` outputs, with the step's attributes."""
+    sl = slice(0, rec.n_valid)
+    E = rec.E[sl]
+    energy = {
+        "energy_kinetic": (E[:, 0], "kinetic energy ½ vᵀ M v"),
+        "energy_strain": (E[:, 1], "elastic strain energy ∫ T²/(2EA) ds"),
+        "energy_potential": (E[:, 2], "potential of gravity and constant loads"),
+        "energy_total": (E.sum(axis=1), "kinetic + strain + potential"),
+    }
+    return results.transient_dataset(rec.mesh, rec.times[sl], rec.X[sl], rec.V[sl], rec.A[sl],
+                                     rec.T[sl], rec.R[sl], energy, dict(rec.attrs))
 
 
-class Outputs:
-    """Positions, velocities, accelerations, tensions, reactions and energies at the output
-    times (NaN where not reached), and the step's dataset from the first ``n_valid``."""
-
-    def __init__(self, prob, times: np.ndarray):
-        mesh = prob.model.mesh
-        self.prob = prob
-        self.times = times
-        nn, ne = mesh.n_nodes, mesh.n_elements
-        self.X = np.full((times.size, nn, 3), np.nan)
-        self.V = np.full_like(self.X, np.nan)
-        self.A = np.full_like(self.X, np.nan)
-        self.T = np.full((times.size, ne, 2), np.nan)
-        self.R = np.full_like(self.X, np.nan)
-        self.E = np.full((times.size, 3), np.nan)
-
-    def record(self, k: int, t: float, y: np.ndarray, yp: np.ndarray) -> None:
-        X, V, A, T, R, E = self.prob.observe(t, y, yp)
-        self.X[k], self.V[k], self.A[k] = X.reshape(-1, 3), V.reshape(-1, 3), A.reshape(-1, 3)
-        self.T[k], self.R[k], self.E[k] = T, R, E
-
-    def dataset(self, n_valid: int, attrs: dict) -> xr.Dataset:
-        sl = slice(0, n_valid)
-        E = self.E[sl]
-        energy = {
-            "energy_kinetic": (E[:, 0], "kinetic energy ½ vᵀ M v"),
-            "energy_strain": (E[:, 1], "elastic strain energy ∫ T²/(2EA) ds"),
-            "energy_potential": (E[:, 2], "potential of gravity and constant loads"),
-            "energy_total": (E.sum(axis=1), "kinetic + strain + potential"),
-        }
-        return results.transient_dataset(self.prob.model.mesh, self.times[sl], self.X[sl],
-                                          self.V[sl], self.A[sl], self.T[sl], self.R[sl],
-                                          energy, attrs)
-
-
-def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
-    """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J (loads with a
-    time function have no potential: their work changes the total energy)."""
-    mesh = model.mesh
-    el = model.elements
-    per_element = el.energies(h, *_GAUSS8)  # strain (exact), ∫ w (z - z_i) ds
-    strain = float(per_element[:, 0].sum())
-    gravity = float(per_element[:, 1].sum() + mesh.w @ (mesh.L0 * X[mesh.conn[:, 0], 2]))
-    # loads inside elements (point-mass weights, constant loads) and at nodes
-    ld = model.loading
-    if ld.internal_s.size:
-        counts = np.diff(ld.internal_ptr)
-        e_of = np.repeat(np.arange(mesh.n_elements), counts)
-        sq = np.zeros((mesh.n_elements, max(int(counts.max()), 1)))
-        slot = np.arange(ld.internal_s.size) - ld.internal_ptr[e_of]
-        sq[e_of, slot] = ld.internal_s
-        xk = X[mesh.conn[:, 0]][:, None, :] + el.position(h, sq)
-        gravity -= float(np.sum(ld.internal_force * xk[e_of, slot]))
-    # only the constant loads have a potential; the work of loads that vary in time (like that
-    # of moving supports) changes the total energy instead
-    gravity -= float(ld.node_force.reshape(-1) @ X.reshape(-1))
-    return strain, gravity
-
-
-def note(model: Model, prob) -> str:
-    """Advice on the result's accuracy that the run itself found ("" when none)."""
-    jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
-    if model.mass_model not in ("consistent", "blended") or not jumps:
-        return ""
-    t, dv, lam2 = jumps[0]
-    return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "
-            "(water-hammer) wave it sends is not carried by the consistent catenary mass of "
-            f"elements that take a chord change by sag (element λ² up to {lam2:.3g} here, "
-            "> 1); tensions may be underestimated (try mass_model = \"lumped\" or \"linear\", "
-            "or more elements; README, Accuracy and known limits)")
+def as_dataset(obj):
+    """A dataset from a solver's result: an output record is turned into one, a dataset (or
+    anything else, e.g. None) is returned as it is."""
+    if hasattr(obj, "n_valid") and hasattr(obj, "times"):
+        return dataset(obj)
+    return obj

@@ -41,15 +41,16 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces, _sym_from_upper
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.model.seabed import SeabedContact
-from catdae.output.transient import potential
+from catdae.model.settings import DampingModel
+from catdae.solvers.layout import UnknownLayout
+from catdae.solvers.record import potential
+from catdae.solvers.start import ConsistentStart
 
 _S = np.hstack([-np.eye(3), np.eye(3)])  # ∂c/∂(u_i, u_j): chord c = x_j - x_i
 
@@ -60,7 +61,7 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return v
 
 
-class TransientProblem:
+class TransientProblem(ConsistentStart):
     """Residual and iteration matrix of one transient step, with evaluation counters."""
 
     def __init__(self, model: Model, step, X0: np.ndarray, h0: np.ndarray | None):
@@ -71,49 +72,18 @@ class TransientProblem:
         if free.size == 0:
             raise SolverError("transient step: the model has no free degree of freedom "
                               "(every node is supported)", termination="no free dof")
-        # --- ordering: reverse Cuthill-McKee on the free-free stiffness graph
-        pat = model.pattern
-        full = sp.csr_matrix((np.ones(pat.nnz), pat.indices, pat.indptr),
-                             shape=(self.n_dof, self.n_dof))
-        ff = full[free][:, free]
-        perm = np.asarray(reverse_cuthill_mckee(ff.tocsr(), symmetric_mode=True), np.int64)
-        self.fidx = free[perm]  # full dof of unknown k
-        self.n = self.fidx.size
-        pos = np.full(self.n_dof, -1, np.int64)
-        pos[self.fidx] = np.arange(self.n)
-        rows = np.repeat(np.arange(self.n_dof), np.diff(pat.indptr))
-        cols = pat.indices.astype(np.int64)
-        keep = (pos[rows] >= 0) & (pos[cols] >= 0)
-        self.ff_sel = np.flatnonzero(keep)  # entries of the full CSR data in the ff block
-        self.ff_a = pos[rows[keep]]
-        self.ff_b = pos[cols[keep]]
-        self.bandwidth = int(np.abs(self.ff_a - self.ff_b).max(initial=0))
-        # --- sparse pattern of J (interleaved): rows 2a (q) and 2a+1 (v)
-        a, b = self.ff_a, self.ff_b
-        n = self.n
-        jr = np.concatenate([2 * np.arange(n), 2 * np.arange(n), 2 * a + 1, 2 * a + 1])
-        jc = np.concatenate([2 * np.arange(n), 2 * np.arange(n) + 1, 2 * b, 2 * b + 1])
-        keys = jc * (2 * n) + jr  # column-major for CSC
-        ukeys, inv = np.unique(keys, return_inverse=True)
-        self.j_nnz = ukeys.size
-        jcsc_rows = (ukeys % (2 * n)).astype(np.int32)
-        jcsc_cols = ukeys // (2 * n)
-        indptr = np.concatenate([[0], np.cumsum(np.bincount(jcsc_cols, minlength=2 * n))])
-        self.j_pattern = sp.csc_matrix((np.ones(self.j_nnz), jcsc_rows, indptr),
-                                       shape=(2 * n, 2 * n))
-        m = a.size
-        self.jmap_qq = inv[:n]
-        self.jmap_qv = inv[n:2 * n]
-        self.jmap_vq = inv[2 * n:2 * n + m]
-        self.jmap_vv = inv[2 * n + m:]
+        self.layout = UnknownLayout(model.pattern, free, self.n_dof)
+        lay = self.layout
+        self.fidx, self.n, self.bandwidth = lay.fidx, lay.n, lay.bandwidth
+        self.ff_sel, self.ff_a, self.ff_b = lay.ff_sel, lay.ff_a, lay.ff_b
+        self.j_pattern, self.j_nnz = lay.j_pattern, lay.j_nnz
+        self.jmap_qq, self.jmap_qv = lay.jmap_qq, lay.jmap_qv
+        self.jmap_vq, self.jmap_vv = lay.jmap_vq, lay.jmap_vv
         # --- damping
-        self.damping = step.damping
-        self.alpha = self.beta = 0.0
-        if self.damping is not None and self.damping.kind == "rayleigh":
-            self.alpha, self.beta = self.damping.coefficients()
-        self.material = self.damping is not None and self.damping.kind == "material"
-        self.lagrangian = step.inertia == "lagrangian" and (
-            model.mass_model in ("consistent", "blended"))
+        self.damping = DampingModel.of_step(step.damping)
+        self.alpha, self.beta = self.damping.alpha, self.damping.beta
+        self.material = self.damping.material
+        self.lagrangian = step.inertia == "lagrangian" and model.mass_model.catenary
         nd = model.n_dof
         self.m_diag = model.diagonal_mass()
         self.c_diag = model.diagonal_mass(model.mesh.c) if self.material else np.zeros(nd)
@@ -135,8 +105,6 @@ class TransientProblem:
         self._fast_setup()
         # the seabed's penalty contact (docs/theory.md §14); None for a scene without one
         self.seabed = SeabedContact.of_step(model)
-        if self.seabed is not None:
-            self._seabed_slots = self.seabed.block_slots(model.pattern).ravel()
 
     def _fast_setup(self) -> None:
         """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
@@ -144,16 +112,16 @@ class TransientProblem:
         mm = m.mass_model
         ne = m.mesh.n_elements
         nd = self.n_dof
-        consistent = mm in ("consistent", "blended")
+        consistent = mm.catenary
         self._want_m = consistent
         self._want_c = self.material and consistent
         self._want_dm = self.lagrangian
-        self._scale = 1.0 - m.lumped_fraction if consistent else 1.0
-        self._use_m = mm != "lumped"
-        self._use_c = self.material and mm != "lumped"
-        self._me = (m.linear_element_mass() if mm == "linear" else
+        self._scale = 1.0 - mm.lumped_fraction if consistent else 1.0
+        self._use_m = not mm.lumped
+        self._use_c = self.material and not mm.lumped
+        self._me = (m.linear_element_mass() if mm.linear else
                     np.zeros((ne, 6, 6)) if consistent else self._dummy3)
-        self._ce = (m.linear_element_mass(damping=True) if mm == "linear" and self.material else
+        self._ce = (m.linear_element_mass(damping=True) if mm.linear and self.material else
                     np.zeros((ne, 6, 6)) if self._want_c else self._dummy3)
         self._dm = np.zeros((ne, 3, 6, 6)) if self._want_dm else self._dummy4
         self._fflat = np.zeros((ne, 6))
@@ -166,7 +134,7 @@ class TransientProblem:
         self._Vb = np.zeros(nd)
         self._Ab = np.zeros(nd)
         self._force = np.zeros(nd)
-        damped = self.damping is not None
+        damped = self.damping.damped
         self._v_diag = (self.c_diag + self.alpha * self.m_diag) if damped else np.zeros(nd)
         self._buffers_at = None  # (t, q) whose element state the buffers hold
         self._res_scratch = np.zeros(2 * self.n)
@@ -274,7 +242,7 @@ class TransientProblem:
         state, me, ce, dm = conf
         el = m.elements
         out = np.empty(self.n_dof)
-        damped = self.damping is not None
+        damped = self.damping.damped
         _dynamic_forces(m.edofs, state.h, el._load_total, self._wl0,
                         me if me is not None else self._dummy3, me is not None,
                         ce if ce is not None else self._dummy3, ce is not None, state.K,
@@ -368,11 +336,7 @@ class TransientProblem:
             vdata = vdata + pat.assemble(cj * ma + kv)
         if self.seabed is not None:  # docs/theory.md §14: -∂f/∂q, -∂f/∂v of the contact
             V, _ = self.full_vectors(t, y[1::2], yp[1::2])
-            kq, kv = self.seabed.derivatives(self._conf_X().reshape(-1, 3), V.reshape(-1, 3))
-            kdata = kdata.copy()
-            vdata = vdata.copy()
-            np.add.at(kdata, self._seabed_slots, kq.ravel())
-            np.add.at(vdata, self._seabed_slots, kv.ravel())
+            kdata, vdata = self.seabed.add_derivatives(kdata, vdata, self._conf_X(), V)
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
@@ -406,58 +370,7 @@ class TransientProblem:
             np.add.at(data, self.jmap_vv, vv)
         JJ[:] = data
 
-    # ------------------------------------------------------------------ start and output
-    def initial(self, t0: float, X: np.ndarray, V: np.ndarray):
-        """Consistent y0, yp0 at the start, from the previous step's positions and velocities."""
-        vs_before = np.asarray(V, float).reshape(-1)[self.model.fixed]
-        return self._consistent(t0, X.reshape(-1)[self.fidx], V.reshape(-1)[self.fidx],
-                                vs_before, "transient start")
-
-    def restart(self, t: float, y: np.ndarray, t_before: float):
-        """Consistent y, yp just after a breakpoint of the prescribed motions or loads at t;
-        the support velocities before it are those at ``t_before``."""
-        vs_before = self.model.support_values(t_before)[1]
-        return self._consistent(t, y[0::2], y[1::2], vs_before, f"restart at t = {t:.6g} s")
-
-    def _consistent(self, t0, q0, v0, vs_before, where):
-        """y0, yp0 with v'(0) = M⁻¹ (P - C v - F - coupling) on the free dofs.
-
-        A prescribed support velocity that jumps at t0 (A = a sin ωt after a rest, the corner
-        of a linear ramp) acts through an impulsive reaction on the supports only: no impulse
-        reaches a free dof, so its generalised momentum p_f = M_ff v_f + M_fs v_s is
-        continuous and the free velocities jump by -M_ff⁻¹ M_fs Δv_s. (Keeping v_f instead
-        would apply an impulse -M_fs Δv_s to the free dofs; with the consistent catenary mass,
-        which amplifies chord motion in slack elements, that impulse grows with the mesh.)
-        With a lumped mass M_fs = 0 and nothing changes.
-        """
-        m = self.model
-        conf = self.configuration(t0, q0)
-        if conf is None:
-            raise SolverError(f"{where}: an element cannot be solved in the configuration",
-                              termination="initial state")
-        mdata = self.mass_data(conf)
-        mff = self.ff(mdata).tocsc()
-        vs_after = self._supports(t0)[1]
-        dvs = vs_after - vs_before
-        # a jump, not the round-off of two evaluations of a smooth motion
-        dvs[np.abs(dvs) <= 1e-12 * max(1.0, float(np.abs(vs_after).max(initial=0.0)))] = 0.0
-        if np.any(dvs):
-            lam2 = m.element_lambda2(conf[0], self.X.reshape(-1, 3))
-            self.velocity_jumps.append((float(t0), float(np.abs(dvs).max()),
-                                        float(lam2.max())))
-        v0 = np.array(v0, float)
-        if np.any(dvs) and m.mass_model != "lumped":
-            full = m.pattern.matrix(mdata)
-            v0 -= spla.spsolve(mff, full[self.fidx][:, m.fixed] @ dvs)
-        V_full, A_full = self.full_vectors(t0, v0, np.zeros(self.n))
-        f = self.dynamic_force(t0, conf, V_full, A_full)  # M_fp a_p + C v + F - P
-        a0 = spla.spsolve(mff, -f[self.fidx])
-        y0 = np.empty(2 * self.n)
-        yp0 = np.empty(2 * self.n)
-        y0[0::2], y0[1::2] = q0, v0
-        yp0[0::2], yp0[1::2] = v0, a0
-        return y0, yp0
-
+    # ------------------------------------------------------------------ output
     def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
         """Positions, velocities, accelerations, tensions, reactions and energies at t (one
         compiled residual pass leaves the element state and forces in the buffers)."""

@@ -1,0 +1,80 @@
+"""What a transient step records at its output times (docs/theory.md §8, §10): positions,
+velocities, accelerations, tensions, reactions and energies as arrays (NaN where not
+reached), and the run's own advice on its accuracy. Datasets are made from them in
+``catdae.output.transient``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catdae.model.assembly import Model
+
+_GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
+
+
+class OutputRecord:
+    """Arrays at the output times ``times``, filled by ``record``; ``n_valid`` of them are
+    reached, and ``attrs`` hold the step's statistics and settings (result attributes)."""
+
+    def __init__(self, prob, times: np.ndarray):
+        mesh = prob.model.mesh
+        self.prob = prob
+        self.mesh = mesh
+        self.times = times
+        nn, ne = mesh.n_nodes, mesh.n_elements
+        self.X = np.full((times.size, nn, 3), np.nan)  # (n_out, n_nodes, 3) m
+        self.V = np.full_like(self.X, np.nan)  # m/s
+        self.A = np.full_like(self.X, np.nan)  # m/s²
+        self.T = np.full((times.size, ne, 2), np.nan)  # (n_out, n_elem, 2) N, end tensions
+        self.R = np.full_like(self.X, np.nan)  # N, support reactions (NaN on free axes)
+        self.E = np.full((times.size, 3), np.nan)  # J: kinetic, strain, potential
+        self.n_valid = 0
+        self.attrs: dict = {}
+
+    def record(self, k: int, t: float, y: np.ndarray, yp: np.ndarray) -> None:
+        X, V, A, T, R, E = self.prob.observe(t, y, yp)
+        self.X[k], self.V[k], self.A[k] = X.reshape(-1, 3), V.reshape(-1, 3), A.reshape(-1, 3)
+        self.T[k], self.R[k], self.E[k] = T, R, E
+
+    def upto(self, n_valid: int, attrs: dict) -> OutputRecord:
+        """This record with its first ``n_valid`` outputs valid and ``attrs`` set."""
+        self.n_valid = n_valid
+        self.attrs = attrs
+        return self
+
+
+def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
+    """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J (loads with a
+    time function have no potential: their work changes the total energy)."""
+    mesh = model.mesh
+    el = model.elements
+    per_element = el.energies(h, *_GAUSS8)  # strain (exact), ∫ w (z - z_i) ds
+    strain = float(per_element[:, 0].sum())
+    gravity = float(per_element[:, 1].sum() + mesh.w @ (mesh.L0 * X[mesh.conn[:, 0], 2]))
+    # loads inside elements (point-mass weights, constant loads) and at nodes
+    ld = model.loading
+    if ld.internal_s.size:
+        counts = np.diff(ld.internal_ptr)
+        e_of = np.repeat(np.arange(mesh.n_elements), counts)
+        sq = np.zeros((mesh.n_elements, max(int(counts.max()), 1)))
+        slot = np.arange(ld.internal_s.size) - ld.internal_ptr[e_of]
+        sq[e_of, slot] = ld.internal_s
+        xk = X[mesh.conn[:, 0]][:, None, :] + el.position(h, sq)
+        gravity -= float(np.sum(ld.internal_force * xk[e_of, slot]))
+    # only the constant loads have a potential; the work of loads that vary in time (like that
+    # of moving supports) changes the total energy instead
+    gravity -= float(ld.node_force.reshape(-1) @ X.reshape(-1))
+    return strain, gravity
+
+
+def note(model: Model, prob) -> str:
+    """Advice on the result's accuracy that the run itself found ("" when none)."""
+    jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
+    if not model.mass_model.catenary or not jumps:
+        return ""
+    t, dv, lam2 = jumps[0]
+    return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "
+            "(water-hammer) wave it sends is not carried by the consistent catenary mass of "
+            f"elements that take a chord change by sag (element λ² up to {lam2:.3g} here, "
+            "> 1); tensions may be underestimated (try mass_model = \"lumped\" or \"linear\", "
+            "or more elements; docs/accuracy.md)")
