@@ -118,7 +118,8 @@ class Model(MassMatrices):
         self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
                                 + ld.mass_value.sum())
         # water and air (docs/theory.md §13); None for a scene without them
-        self.fluid = Fluid.of(case, mesh, self.lumped_fraction, self.gauss_s, self.gauss_w)
+        self.fluid = Fluid.of(case, mesh, self.mass_model.lumped_fraction, self.gauss_s,
+                              self.gauss_w)
 
     # -------------------------------------------------------------------------------- loads
     def set_time(self, t: float) -> None:
