@@ -5,8 +5,9 @@
 Scenes (tests/moordyn_scenes.py, data in tests/data/moordyn with MoorDyn's BSD-3 notice):
 the studless chain against OrcaFlex at 200 and 600 m depth under the 2 m and 5 m fairlead heave
 records (metric: max |ΔT - ΔT_ref| / (2 max |ΔT_ref|), tolerance 0.15), and the Lowe & Langley
-(2006) jumper, cases 2 and 3 (largest |T - T_paper| over 80 s after the ramp; tolerance 1 kN
-in MoorDyn's test, 1.5 kN for a line without bending stiffness).
+(2006) jumper, cases 2-3 (top motion; largest |T - T_paper| over 80 s after the ramp) and
+4-6 (Airy waves; over 30 s after two periods); tolerance 1 kN in MoorDyn's test, 1.5 kN for a
+line without bending stiffness.
 
 catdae: each scene on a small ladder of (elements, rtol), cheapest first; the cost is the CPU
 time (time.process_time) and wall time of the whole ``catdae.run`` (static step, start-up of
@@ -37,6 +38,8 @@ from moordyn_scenes import (  # noqa: E402
     DATA,
     JUMPER_AMPLITUDE,
     JUMPER_PERIOD,
+    WAVE_CASES,
+    WAVE_PERIOD,
     chain_metric,
     chain_toml,
     jumper_error,
@@ -149,6 +152,52 @@ def moordyn_jumper(md, case, dtm, folder):
     return jumper_error(np.array(times), tens, case), cpu / t, wall / t
 
 
+def _wave(A, T, phi, d, t, r):
+    """MoorDyn's test programme's Airy kinematics (deep-water k, finite-depth profile)."""
+    omega = 2.0 * math.pi / T
+    k = omega * omega / 9.81
+    x = r[:, 0] * math.cos(d) + r[:, 1] * math.sin(d)
+    cs, ss = np.cos(k * x - omega * t + phi), np.sin(k * x - omega * t + phi)
+    ch = np.cosh(k * (r[:, 2] + 100.0)) / math.cosh(k * 100.0)
+    sh = np.sinh(k * (r[:, 2] + 100.0)) / math.cosh(k * 100.0)
+    ua, aa = omega * A, omega * omega * A
+    u = np.stack([ua * cs * ch * math.cos(d), ua * cs * ch * math.sin(d), ua * ss * sh], 1)
+    a = np.stack([aa * ss * ch * math.cos(d), aa * ss * ch * math.sin(d), -aa * cs * sh], 1)
+    return u, a
+
+
+def moordyn_jumper_waves(md, case, dtm, folder):
+    src = DATA / "lowe_and_langley_2006" / "line.txt"
+    phase, heading = WAVE_CASES[case]
+    c0, w0 = time.process_time(), time.perf_counter()
+    s = md.Create(str(_input(src, folder, dtm)))
+    try:
+        point = md.GetPoint(s, 2)
+        line = md.GetLine(s, 1)
+        r = list(md.GetPointPos(point))
+        md.Init(s, r, [0.0, 0.0, 0.0])
+        md.ExternalWaveKinInit(s)
+        n = md.GetLineN(line)
+        t, dt = 0.0, 0.005
+        times, tens = [], []
+        while t < 30.0 + 2 * WAVE_PERIOD:
+            pts = np.array(md.ExternalWaveKinGetCoordinates(s)).reshape(-1, 3)
+            u, a = _wave(5.0, WAVE_PERIOD, math.radians(phase), math.radians(heading),
+                         t + 0.5 * dt, pts)
+            md.ExternalWaveKinSet(s, u.tolist(), a.tolist(), t + 0.5 * dt)
+            md.Step(s, r, [0.0, 0.0, 0.0], t, dt)
+            t += dt
+            times.append(t)
+            tens.append(float(np.linalg.norm(md.GetLineNodeForce(line, n))))
+    finally:
+        md.Close(s)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    tens = np.array(tens)
+    if not np.all(np.isfinite(tens)):
+        raise FloatingPointError("NaN")
+    return jumper_error(np.array(times), tens, case), cpu / t, wall / t
+
+
 def moordyn_ladder(run, dtm0, n=4):
     """Runs at dtM, 2 dtM, 4 dtM, ... while stable: [(dtm, error, cpu/s, wall/s)]."""
     out = []
@@ -175,7 +224,7 @@ def main(argv=None):
 
     chains = [(200, "ZZP1_A1")] if args.quick else [
         (200, "ZZP1_A1"), (200, "ZZP1_A2"), (600, "ZZP1_A1"), (600, "ZZP1_A2")]
-    jumpers = [2] if args.quick else [2, 3]
+    jumpers = [2] if args.quick else [2, 3, 4, 5, 6]
     rows = []
     # warm the kernels (compiled once per source change; not part of any cost)
     catdae.run(load_case(chain_toml(200, motion="ZZP1_A1", elements=4, rtol=1e-2,
@@ -197,8 +246,9 @@ def main(argv=None):
             err, cpu, wall, steps = catdae_jumper(case, elements, rtol)
             rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err / 1e3,
                          JUMPER_TOL / 1e3, cpu, wall, f"{steps} steps"))
+        run = moordyn_jumper_waves if case in WAVE_CASES else moordyn_jumper
         for dtm, err, cpu, wall in moordyn_ladder(
-                lambda dtm, folder, c=case: moordyn_jumper(md, c, dtm, folder), 0.001):
+                lambda dtm, folder, c=case, run=run: run(md, c, dtm, folder), 0.001):
             e = err if isinstance(err, str) else err / 1e3
             rows.append((scene, f"MoorDyn 68 segs, EI, dtM {dtm:g} s", e, JUMPER_TOL / 1e3,
                          cpu, wall, "midpoint5"))
