@@ -158,7 +158,12 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
         return _modal_step(step, model, state)
     from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 
-    return as_dataset(run_transient(step, model, state, writer, progress))
+    ds = as_dataset(run_transient(step, model, state, writer, progress))
+    if model.case.seabed is not None:  # touchdown and length on the seabed over time (§14)
+        from catdae.output.seabed import add_seabed_history
+
+        ds = add_seabed_history(ds, model.mesh, model.case.seabed.z)
+    return ds
 
 
 def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _State):

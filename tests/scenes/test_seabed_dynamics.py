@@ -205,3 +205,7 @@ def test_bundled_mooring_case_statics_and_a_cheap_run():
     tr = tree["heave_surge"].to_dataset()
     assert tr.attrs["status"] == "completed"
     assert np.all(np.isfinite(tr.position.values))
+    # the lying length over time at node resolution, near the static one
+    lying_static = float(st.seabed_length.item())
+    assert np.all(np.abs(tr.seabed_length.values - lying_static) <= 3 * 38.0)
+    assert np.all(np.isfinite(tr.touchdown.values))
