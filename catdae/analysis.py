@@ -160,9 +160,11 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
 
     ds = as_dataset(run_transient(step, model, state, writer, progress))
     if model.case.seabed is not None:  # touchdown and length on the seabed over time (§14)
+        from catdae.model.seabed import SeabedContact
         from catdae.output.seabed import add_seabed_history
 
-        ds = add_seabed_history(ds, model.mesh, model.case.seabed.z)
+        ds = add_seabed_history(ds, model.mesh, model.case.seabed.z,
+                                SeabedContact.of_step(model))
     return ds
 
 

@@ -3,6 +3,8 @@ length resting on the seabed and the touchdown point."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from catdae._xr import xr
 from catdae.output.results import _label, _var
 
@@ -18,13 +20,11 @@ def add_seabed(ds: xr.Dataset, mesh, summary: dict) -> xr.Dataset:
     return ds
 
 
-def add_seabed_history(ds: xr.Dataset, mesh, zb: float) -> xr.Dataset:
+def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Dataset:
     """A transient group with ``seabed_length``(time, cable) and ``touchdown``(time, cable,
     axis) at node resolution, from the node positions: nodes at or below the seabed are in
     contact; an element counts whole with both nodes in contact, half with one; the touchdown
     is the last node in contact before the cable leaves the seabed, from its first end."""
-    import numpy as np
-
     if "position" not in ds or "time" not in ds.dims:
         return ds
     z = ds.position.sel(axis="z").transpose("time", "node").values  # (nt, n_nodes)
@@ -53,4 +53,13 @@ def add_seabed_history(ds: xr.Dataset, mesh, zb: float) -> xr.Dataset:
                                "unstrained length of cable resting on the seabed")
     ds["touchdown"] = _var(("time", "cable", "axis"), td, "m",
                            "touchdown point: where the cable leaves the seabed (NaN: none)")
+    if contact is not None:  # the power the seabed's damping and friction take out, and its work
+        vel = ds.velocity.transpose("time", "node", "axis").values[:, order]
+        power = np.array([contact.dissipation(pos[k], vel[k]) for k in range(z.shape[0])])
+        t = ds.time.values
+        work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+        ds["seabed_dissipation"] = _var("time", power, "W",
+                                        "power taken out by the seabed's damping and friction")
+        ds["seabed_work"] = _var("time", work, "J", "energy taken out by the seabed's damping "
+                                 "and friction since the step's start (trapezoidal rule)")
     return ds
