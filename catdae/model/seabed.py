@@ -112,6 +112,7 @@ class GroundedModel(Model):
         conn = model.mesh.conn
         oi, oj = on[conn[:, 0]], on[conn[:, 1]]
         mode = np.where(oi & oj, g.LYING, np.where(oi, g.AT_I, np.where(oj, g.AT_J, g.FREE)))
+        mode[model.elements.w <= 0.0] = g.FREE  # weightless or buoyant: nothing to lay down
         self.mode = mode.astype(np.int64)
         bad = (np.diff(model.elements.loads.ptr) > 0) & (self.mode != g.FREE)
         if bad.any():
