@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+
 from catdae._version import __version__
 from catdae.element.cache import purge_stale as _purge_stale
 from catdae.errors import (
@@ -43,11 +48,31 @@ __all__ = ["CaseError", "CatdaeError", "ConvergenceError", "Interrupted", "Outpu
            "SolverError", "__version__", "load_case", "read_results", "run"]
 
 
+_PUBLIC = {"plot": "catdae.output.plot", "export": "catdae.output.export"}
+
+
 def __getattr__(name):
     """``catdae.plot`` and ``catdae.export`` (catdae/output/) on first use (matplotlib, meshio
     load then)."""
-    if name in ("plot", "export"):
-        import importlib
-
-        return importlib.import_module(f"catdae.output.{name}")
+    if name in _PUBLIC:
+        return importlib.import_module(_PUBLIC[name])
     raise AttributeError(f"module 'catdae' has no attribute {name!r}")
+
+
+class _PublicModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """``import catdae.plot`` / ``from catdae.export import write_vtk`` (the documented names)
+    give the modules in catdae/output/, loaded on first use."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        real = _PUBLIC.get(fullname.removeprefix("catdae.")) if fullname.startswith(
+            "catdae.") else None
+        return importlib.util.spec_from_loader(fullname, self) if real else None
+
+    def create_module(self, spec):
+        return importlib.import_module(_PUBLIC[spec.name.removeprefix("catdae.")])
+
+    def exec_module(self, module):
+        pass  # the real module is already executed
+
+
+sys.meta_path.append(_PublicModules())

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from catdae._version import __version__
+from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CaseError, CatdaeError, OutputError
 from catdae.interrupts import signals_as_interrupts
 
@@ -41,7 +42,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--rtol", type=float, help="relative tolerance of transient steps")
     r.add_argument("--atol", type=float, help="absolute tolerance of transient steps, m")
     r.add_argument("--elements", type=int, help="elements per cable")
-    r.add_argument("--mass-model", choices=("auto", "blended", "consistent", "lumped", "linear"),
+    r.add_argument("--mass-model", choices=MASS_MODEL_NAMES,
                    help="mass model of every transient and modal step")
     r.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: on a terminal)")

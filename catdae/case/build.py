@@ -31,6 +31,7 @@ from catdae.case.model import (
     FrozenMap,
     Material,
 )
+from catdae.case.names import cable_of
 from catdae.case.schema import (
     _VEC3,
     _Load,
@@ -285,7 +286,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _SeabedPass):
               loads: list, distributed: list) -> None:
         """A weightless cable with no load on it and length >= chord has no defined shape."""
         loaded = {x.cable for x in (*point_masses, *loads) if x.cable is not None}
-        loaded |= {x.node.rpartition(".")[0] for x in (*point_masses, *loads)
+        loaded |= {cable_of(x.node) for x in (*point_masses, *loads)
                    if x.node is not None and "." in x.node}
         loaded |= {d.cable for d in distributed}
         for name, (i, c) in cables.items():

@@ -19,6 +19,7 @@ from catdae.case.model import (
     Load,
     PointMass,
 )
+from catdae.case.names import cable_of, mesh_node, split_mesh_node
 from catdae.case.schema import (
     FORM_TARGETS,
     _Cable,
@@ -143,8 +144,8 @@ class _CablesPass:
                              "carries what is placed on it")
                 return False
             return True
-        cable, dot, _k = ref.rpartition(".")
-        if dot and cable in self.cable_names:
+        cable = cable_of(ref)
+        if cable and cable in self.cable_names:
             if cable not in cables:
                 return False  # the cable itself is invalid and already reported
             msg = _mesh_node_problem(ref, {n: c.elements for n, (_, c) in cables.items()})
@@ -153,7 +154,7 @@ class _CablesPass:
                 return False
             return True
         choices = sorted(self.node_names) + [
-            f"{n}.{k}" for n, (_, c) in cables.items() for k in range(1, min(c.elements, 100))
+            mesh_node(n, k) for n, (_, c) in cables.items() for k in range(1, min(c.elements, 100))
         ]
         self.problem(where, _unknown(ref, "node", choices))
         return False
@@ -267,8 +268,8 @@ class _CablesPass:
 
 def _mesh_node_problem(ref: str, elements: Mapping[str, int]) -> str | None:
     """Why ``<cable>.<k>`` is not a mesh node of one of ``elements`` (cable -> count), or None."""
-    cable, dot, k = ref.rpartition(".")
-    if not dot or cable not in elements:
+    cable, k = split_mesh_node(ref) or ("", "")
+    if cable not in elements:
         return _unknown(ref, "node", sorted(elements))
     n = elements[cable]
     if k.isdigit() and k.isascii() and 1 <= int(k) <= n - 1:

@@ -12,15 +12,19 @@ from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
+from pydantic import ValidationError
+
 from catdae.case.fluid import Air, Water
-from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, size_problems
-from catdae.case.messages import _found, _is_number
+from catdae.case.limits import size_problems
+from catdae.case.messages import _message
+from catdae.case.names import mesh_node, split_mesh_node
+from catdae.case.schema import _Overrides
 from catdae.case.timefunc import TimeFunction
 from catdae.errors import CaseError
 
 AXES = ("x", "y", "z")
 # docs/case-format.md, mass_model
-MASS_MODELS = ("auto", "blended", "consistent", "lumped", "linear")
+
 
 
 class FrozenMap(Mapping):
@@ -317,28 +321,22 @@ class Case:
     def with_overrides(self, rtol: float | None = None, atol: float | None = None,
                        elements: int | None = None, mass_model: str | None = None) -> Case:
         """A new Case with ``rtol``/``atol`` set on every transient step, ``mass_model``
-        (one of ``MASS_MODELS``) on every transient and modal step, and ``elements`` on
+        (one of ``schema.MASS_MODEL_NAMES``) on every transient and modal step, and ``elements`` on
         every cable (``None`` leaves a setting as it is).
 
         With a new ``elements``, a load or point mass placed on a mesh node ``<cable>.<k>`` is
         kept at the same place on the cable (its unstrained arc length in the case's mesh).
         Raises ``CaseError`` if a value is invalid.
         """
-        problems: list[tuple[str, str]] = []
-        for key, value in (("rtol", rtol), ("atol", atol)):
-            if value is not None and not (_is_number(value) and 0 < value < math.inf):
-                problems.append((key, f"expected a finite number > 0, found {_found(value)}"))
-        if elements is not None and not (
-            isinstance(elements, numbers.Integral) and not isinstance(elements, bool)
-            and 1 <= elements <= MAX_ELEMENTS_PER_CABLE
-        ):
-            problems.append(("elements", f"expected an integer >= 1 and <= "
-                             f"{MAX_ELEMENTS_PER_CABLE}, found {_found(elements)}"))
-        if mass_model is not None and mass_model not in MASS_MODELS:
-            problems.append(("mass_model", 'expected "auto", "blended", "consistent", '
-                             f'"lumped" or "linear", found {_found(mass_model)}'))
-        if problems:
-            raise CaseError(self.path, problems)
+        given = {"rtol": rtol, "atol": atol, "mass_model": mass_model,
+                 "elements": (int(elements) if isinstance(elements, numbers.Integral)
+                              and not isinstance(elements, bool) else elements)}
+        try:
+            _Overrides.model_validate({k: v for k, v in given.items() if v is not None})
+        except ValidationError as exc:
+            fields = list(_Overrides.model_fields)
+            raise CaseError(self.path, [(str(err["loc"][0]), _message(err, fields, {}))
+                                        for err in exc.errors()]) from None
         steps = tuple(
             replace(s, rtol=float(rtol if rtol is not None else s.rtol),
                     atol=float(atol if atol is not None else s.atol))
@@ -360,7 +358,7 @@ class Case:
             def keep_place(item):
                 if item.node is None or item.node in self.nodes:
                     return item
-                cable, _, k = item.node.rpartition(".")
+                cable, k = split_mesh_node(item.node)
                 c = by_name[cable]
                 if c.length is None:  # form-found: the length is not known yet
                     k_new = int(k) * int(elements) / c.elements
@@ -370,7 +368,7 @@ class Case:
                             f"whose length is found by form-finding; with {elements} elements "
                             "it would fall between mesh nodes: use a multiple of "
                             f"{c.elements} elements"))])
-                    return replace(item, node=f"{cable}.{int(k_new)}")
+                    return replace(item, node=mesh_node(cable, k_new))
                 return replace(item, node=None, cable=cable, s=int(k) * c.length / c.elements)
 
             point_masses = tuple(keep_place(p) for p in point_masses)

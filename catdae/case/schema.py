@@ -7,7 +7,7 @@ functions) are validated later, against the model their kind selects.
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
@@ -21,6 +21,10 @@ Time = Annotated[float, Field(ge=MIN_TIME)]  # s: shorter is degenerate (0/0 in 
 Frequency = Annotated[float, Field(gt=0, le=MAX_FREQUENCY)]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Name = Annotated[str, Field(min_length=1)]
+# settings a command line may override too (``_Overrides``): one type for both
+Elements = Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)]
+MassModelName = Literal["auto", "blended", "consistent", "lumped", "linear"]
+MASS_MODEL_NAMES = get_args(MassModelName)
 TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
 
 
@@ -65,7 +69,7 @@ class _Cable(BaseModel):
     material: Name
     length: Pos | None = None  # exactly one of length and form (checked by the builder)
     form: TomlTable | None = None
-    elements: Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)] = 1
+    elements: Elements = 1
     gauss_points: Annotated[int, Field(ge=1, le=10)] = 3
 
 
@@ -127,7 +131,7 @@ class _ModalStep(BaseModel):
     temperature_change: Any = None
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
-    mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
+    mass_model: MassModelName = "auto"
 
 
 class _TransientStep(BaseModel):
@@ -144,7 +148,7 @@ class _TransientStep(BaseModel):
     damping: TomlTable | None = None
     max_order: Any = "auto"  # "auto" or an integer 1-5 (checked by the builder)
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
-    mass_model: Literal["auto", "blended", "consistent", "lumped", "linear"] = "auto"
+    mass_model: MassModelName = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
 
 
@@ -225,3 +229,14 @@ _TIME_MODELS: dict[str, type[BaseModel]] = {
 }
 
 _VEC3 = TypeAdapter(Vec3, config=ConfigDict(strict=True, allow_inf_nan=False))
+
+
+class _Overrides(BaseModel):
+    """What ``catdae run --rtol/--atol/--elements/--mass-model`` (and the keywords of
+    ``catdae.run``) may replace, typed as the case file's own fields."""
+
+    model_config = _STRICT
+    rtol: Pos | None = None  # as a transient step's rtol
+    atol: Pos | None = None  # as a transient step's atol
+    elements: Elements | None = None  # as a cable's elements
+    mass_model: MassModelName | None = None  # as a modal or transient step's mass_model

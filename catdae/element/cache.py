@@ -19,8 +19,8 @@ import hashlib
 from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
-                  "element/mass_gradient", "element/residual_kernel", "element/grounded",
-                  "element/fluid_kernel")
+                  "element/mass_gradient", "element/residual_kernel", "element/fluid_kernel",
+                  "element/fluid_kinematics", "element/grounded")
 _STAMP = "catdae-kernels.sha256"
 
 

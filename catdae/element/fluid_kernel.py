@@ -13,137 +13,50 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-# kinds of current and wind
-NONE, UNIFORM, PROFILE, POWER, LOG = 0, 1, 2, 3, 4
-
-
-@njit(cache=True, inline="always")
-def _profile(kind, z, vec, zs, vs, speed, direction, expo, z_ref, ground, u, du):
-    """Velocity u (3,) and its derivative along z du (3,) of a current or wind at height z."""
-    for a in range(3):
-        u[a] = 0.0
-        du[a] = 0.0
-    if kind == UNIFORM:
-        for a in range(3):
-            u[a] = vec[a]
-    elif kind == PROFILE:
-        n = zs.shape[0]
-        if z <= zs[0]:
-            for a in range(3):
-                u[a] = vs[0, a]
-        elif z >= zs[n - 1]:
-            for a in range(3):
-                u[a] = vs[n - 1, a]
-        else:
-            k = np.searchsorted(zs, z) - 1
-            dz = zs[k + 1] - zs[k]
-            r = (z - zs[k]) / dz
-            for a in range(3):
-                u[a] = vs[k, a] + r * (vs[k + 1, a] - vs[k, a])
-                du[a] = (vs[k + 1, a] - vs[k, a]) / dz
-    elif kind == POWER or kind == LOG:
-        height = z - ground
-        if height <= 0.0:
-            return
-        if kind == POWER:
-            f = (height / z_ref) ** expo
-            df = expo * f / height
-        else:  # expo holds the roughness length z0
-            if height <= expo:
-                return
-            c = 1.0 / np.log(z_ref / expo)
-            f = np.log(height / expo) * c
-            df = c / height
-        for a in range(3):
-            u[a] = speed * f * direction[a]
-            du[a] = speed * df * direction[a]
-
-
-@njit(cache=True, inline="always")
-def _depth_ratios(k, z, depth):
-    """cosh(k (z + d)) / sinh(k d) and sinh(k (z + d)) / sinh(k d) for z <= 0, without
-    overflow (deep water: depth = inf gives exp(k z) for both)."""
-    e = np.exp(k * z)
-    if np.isinf(depth):
-        return e, e
-    em = np.exp(-k * (z + 2.0 * depth))
-    den = 1.0 - np.exp(-2.0 * k * depth)
-    return (e + em) / den, (e - em) / den
+from catdae.element.fluid_kinematics import _profile, surface_elevation, wave_kinematics
 
 
 @njit(cache=True)
-def wave_kinematics(x, y, z, t, surface, depth, amp, omega, wk, cosb, sinb, phase, ramp, dramp,
-                    u, a, gu, ga):
-    """Surface elevation above the still level at (x, y) and, at height z (local z relative to
-    the still level, taken at min(z, 0) above it), the wave particle velocity u (3,),
-    acceleration a (3,), velocity gradient gu (3, 3) [gu[i, j] = ∂u_i/∂x_j] and acceleration
-    gradient ga (3, 3) of a sum of
-    linear (Airy) components with finite-depth dispersion, times the ramp factor ``ramp``
-    (with time derivative ``dramp``). docs/theory.md §13.3."""
-    zr = z - surface
-    clip = zr > 0.0
-    if clip:
-        zr = 0.0
-    eta = 0.0
-    for i in range(3):
-        u[i] = 0.0
-        a[i] = 0.0
-        for j in range(3):
-            gu[i, j] = 0.0
-            ga[i, j] = 0.0
-    for c in range(amp.shape[0]):
-        kx = wk[c] * cosb[c]
-        ky = wk[c] * sinb[c]
-        th = kx * x + ky * y - omega[c] * t + phase[c]
-        ct = np.cos(th)
-        st = np.sin(th)
-        eta += amp[c] * ct
-        ch, sh = _depth_ratios(wk[c], zr, depth)
-        aw = amp[c] * omega[c]
-        uh = aw * ch * ct  # horizontal speed along the heading
-        uz = aw * sh * st
-        duh_dt = aw * omega[c] * ch * st
-        duz_dt = -aw * omega[c] * sh * ct
-        u[0] += uh * cosb[c]
-        u[1] += uh * sinb[c]
-        u[2] += uz
-        a[0] += ramp * duh_dt * cosb[c] + dramp * uh * cosb[c]
-        a[1] += ramp * duh_dt * sinb[c] + dramp * uh * sinb[c]
-        a[2] += ramp * duz_dt + dramp * uz
-        # gradients: ∂/∂x_h of cos θ = -k_h sin θ; ∂/∂z of ch = k sh, of sh = k ch
-        dh_dx = -aw * ch * st
-        dz_dx = aw * sh * ct
-        kz_h = 0.0 if clip else aw * wk[c] * sh * ct
-        kz_z = 0.0 if clip else aw * wk[c] * ch * st
-        gu[0, 0] += dh_dx * kx * cosb[c]
-        gu[0, 1] += dh_dx * ky * cosb[c]
-        gu[0, 2] += kz_h * cosb[c]
-        gu[1, 0] += dh_dx * kx * sinb[c]
-        gu[1, 1] += dh_dx * ky * sinb[c]
-        gu[1, 2] += kz_h * sinb[c]
-        gu[2, 0] += dz_dx * kx
-        gu[2, 1] += dz_dx * ky
-        gu[2, 2] += kz_z
-        # acceleration gradient: a = ramp ∂u/∂t + dramp u
-        w_ = omega[c]
-        hx_ = ramp * aw * w_ * ch * ct - dramp * aw * ch * st  # ∂a_h/∂θ
-        zx_ = ramp * aw * w_ * sh * st + dramp * aw * sh * ct  # ∂a_z/∂θ
-        hz_ = 0.0 if clip else wk[c] * (ramp * aw * w_ * sh * st + dramp * aw * sh * ct)
-        zz_ = 0.0 if clip else wk[c] * (-ramp * aw * w_ * ch * ct + dramp * aw * ch * st)
-        ga[0, 0] += hx_ * kx * cosb[c]
-        ga[0, 1] += hx_ * ky * cosb[c]
-        ga[0, 2] += hz_ * cosb[c]
-        ga[1, 0] += hx_ * kx * sinb[c]
-        ga[1, 1] += hx_ * ky * sinb[c]
-        ga[1, 2] += hz_ * sinb[c]
-        ga[2, 0] += zx_ * kx
-        ga[2, 1] += zx_ * ky
-        ga[2, 2] += zz_
-    for i in range(3):
-        u[i] *= ramp
-        for j in range(3):
-            gu[i, j] *= ramp
-    return ramp * eta
+def _buoyancy(e, i, j, X, t, c, b, surface, amp, omega, wk, cosb, sinb, phase, ramp, want_jac,
+              out, kx):
+    """Buoyancy of element e (c = ρ g A L0 N) on its nodes, integrated exactly along the
+    straight chord over the part below the surface (the height above the surface, d(ξ) =
+    (1 - ξ) d_i + ξ d_j, linear between the nodes' heights above it), less the share ``b`` (1 or
+    0) its weight already holds: ∫ N_a χ dξ in closed form, so that it is continuous in the
+    node positions (docs/theory.md §13.1); with ``want_jac`` its derivative into ``kx``."""
+    ei, gxi, gyi = surface_elevation(X[i], X[i + 1], t, amp, omega, wk, cosb, sinb, phase,
+                                     ramp)
+    ej, gxj, gyj = surface_elevation(X[j], X[j + 1], t, amp, omega, wk, cosb, sinb, phase,
+                                     ramp)
+    di = X[i + 2] - surface - ei
+    dj = X[j + 2] - surface - ej
+    i1 = i2 = 0.0
+    d1_di = d1_dj = d2_di = d2_dj = 0.0
+    if di <= 0.0 and dj <= 0.0:
+        i1 = i2 = 0.5
+    elif di <= 0.0 or dj <= 0.0:
+        den = di - dj
+        xs = di / den  # where the chord meets the surface
+        xs_di = -dj / (den * den)
+        xs_dj = di / (den * den)
+        if di <= 0.0:  # wet on [0, ξ*]
+            i1, i2 = xs - 0.5 * xs * xs, 0.5 * xs * xs
+            g1, g2 = 1.0 - xs, xs
+        else:  # wet on [ξ*, 1]
+            i1, i2 = 0.5 * (1.0 - xs) * (1.0 - xs), 0.5 - 0.5 * xs * xs
+            g1, g2 = -(1.0 - xs), -xs
+        d1_di, d1_dj, d2_di, d2_dj = g1 * xs_di, g1 * xs_dj, g2 * xs_di, g2 * xs_dj
+    out[i + 2] -= c * (i1 - 0.5 * b)
+    out[j + 2] -= c * (i2 - 0.5 * b)
+    if want_jac and (d1_di != 0.0 or d1_dj != 0.0):
+        # ∂d_i/∂x_i = (-∂η/∂x, -∂η/∂y, 1) at node i, likewise j
+        for a in range(3):
+            dd_i = 1.0 if a == 2 else (-gxi if a == 0 else -gyi)
+            dd_j = 1.0 if a == 2 else (-gxj if a == 0 else -gyj)
+            kx[e, 2, a] -= c * d1_di * dd_i
+            kx[e, 2, 3 + a] -= c * d1_dj * dd_j
+            kx[e, 5, a] -= c * d2_di * dd_i
+            kx[e, 5, 3 + a] -= c * d2_dj * dd_j
 
 
 @njit(cache=True)
@@ -155,7 +68,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
     """Fluid forces on the nodes of every element at time t.
 
     ``out`` (n_dof,) receives M_a A - f: the added-mass force minus the fluid force (buoyancy
-    of the Gauss points not already in the element's weight, drag, Froude-Krylov), i.e. what the
+    not already in the element's weight, drag, Froude-Krylov), i.e. what the
     fluid adds to the dynamic force M A + C V + F - P of the residual. ``ma`` (n_elem, 6, 6)
     receives the element added-mass matrices; with ``want_jac``, ``kx`` and ``kv`` (n_elem, 6, 6)
     the derivatives of ``out`` with respect to the positions and velocities of the element's
@@ -211,6 +124,9 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                     kx[e, r, c] = 0.0
                     kv[e, r, c] = 0.0
         bsum[0, 0] = bsum[0, 1] = bsum[1, 0] = bsum[1, 1] = 0.0
+        if rho_w > 0.0 and area[e] > 0.0:
+            _buoyancy(e, i, j, X, t, rho_w * g * area[e] * l0[e], in_weight[e], surface, amp,
+                      omega, wk, cosb, sinb, phase, ramp, want_jac, out, kx)
         for q in range(ng):
             wq = gw[e, q]
             if wq == 0.0:
@@ -255,12 +171,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
             else:
                 rho = 0.0
             wl = wq * l0[e]  # m of unstrained line at this point
-            # buoyancy of the point, less what the element's weight already holds
-            fb = rho_w * g * area[e] * ((1.0 if wet else 0.0) - in_weight[e])
             if rho == 0.0:
-                if fb != 0.0:
-                    out[i + 2] -= wl * n1 * fb
-                    out[j + 2] -= wl * n2 * fb
                 continue
             # relative velocity, split along τ
             ut = 0.0
@@ -283,7 +194,6 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                 if wet:
                     fg[a] += fk * ((1.0 + can[e]) * (af[a] - aft * tau[a])
                                    + (1.0 + caa[e]) * aft * tau[a])
-            fg[2] += fb
             for a in range(3):
                 out[i + a] -= wl * n1 * fg[a]
                 out[j + a] -= wl * n2 * fg[a]
@@ -373,39 +283,3 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                         for b in range(3):
                             kx[e, 3 * r + a, b] -= bsum[r, c] * dt_m[a, b]
                             kx[e, 3 * r + a, 3 + b] += bsum[r, c] * dt_m[a, b]
-
-
-@njit(cache=True)
-def point_kinematics(pts, t, rho_w, surface, depth, c_kind, c_vec, c_z, c_v, c_fac,
-                     amp, omega, wk, cosb, sinb, phase, ramp, dramp,
-                     rho_a, a_kind, a_vec, a_speed, a_dir, a_expo, a_zref, a_ground, a_fac,
-                     eta_out, vel_out):
-    """Surface elevation above the still level at the points' (x, y), ``eta_out`` (n,), and the
-    fluid velocity at the points, ``vel_out`` (n, 3): current and waves below the surface, wind
-    above it (the same kinematics as ``fluid_pass``)."""
-    u = np.empty(3)
-    a = np.empty(3)
-    du = np.empty(3)
-    ur = np.empty(3)
-    gu = np.zeros((3, 3))
-    ga = np.zeros((3, 3))
-    for p in range(pts.shape[0]):
-        eta = 0.0
-        for k in range(3):
-            u[k] = 0.0
-        if amp.shape[0] > 0:
-            eta = wave_kinematics(pts[p, 0], pts[p, 1], pts[p, 2], t, surface, depth, amp,
-                                  omega, wk, cosb, sinb, phase, ramp, dramp, u, a, gu, ga)
-        eta_out[p] = eta
-        if rho_w > 0.0 and pts[p, 2] <= surface + eta:
-            _profile(c_kind, pts[p, 2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur, du)
-            for k in range(3):
-                vel_out[p, k] = u[k] + c_fac * ur[k]
-        elif rho_a > 0.0:
-            _profile(a_kind, pts[p, 2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
-                     a_ground, ur, du)
-            for k in range(3):
-                vel_out[p, k] = a_fac * ur[k]
-        else:
-            for k in range(3):
-                vel_out[p, k] = 0.0

@@ -21,13 +21,13 @@ import numpy as np
 from catdae.case import Case
 from catdae.case.fluid import Waves
 from catdae.case.timefunc import Ramp
-from catdae.element.fluid_kernel import (
+from catdae.element.fluid_kernel import fluid_pass
+from catdae.element.fluid_kinematics import (
     LOG,
     NONE,
     POWER,
     PROFILE,
     UNIFORM,
-    fluid_pass,
     point_kinematics,
 )
 
@@ -35,9 +35,8 @@ _EMPTY = np.zeros(0)
 
 
 def line_weight(case: Case, cable) -> float:
-    """Weight per unstrained metre that the elements of ``cable`` carry (N/m): the material's,
-    less the buoyancy ρ g π d²/4 when the cable lies wholly in still water
-    (:func:`buoyancy_in_weight`)."""
+    """Weight per unstrained metre under which a cable is meshed (N/m): the material's, less the
+    buoyancy ρ g π d²/4 when the cable lies wholly in still water (:func:`buoyancy_in_weight`)."""
     mat = case.material_of(cable)
     if not buoyancy_in_weight(case, cable):
         return mat.weight
@@ -45,9 +44,8 @@ def line_weight(case: Case, cable) -> float:
 
 
 def buoyancy_in_weight(case: Case, cable) -> bool:
-    """Whether a cable's buoyancy is held in its element weight: water, a diameter, both ends
-    at or below the still-water level and a submerged weight >= 0 (the catenary then hangs
-    below its chord, so wholly under water)."""
+    """Whether a whole cable lies in still water: water, a diameter, both ends at or below the
+    still-water level and a submerged weight >= 0 (the catenary then hangs below its chord)."""
     water = case.water
     mat = case.material_of(cable)
     if water is None or mat.diameter <= 0.0:
@@ -55,6 +53,26 @@ def buoyancy_in_weight(case: Case, cable) -> bool:
     ends = [case.nodes[n][2] for n in cable.ends]
     wsub = mat.weight - water.density * case.gravity * _area(mat.diameter)
     return max(ends) <= water.surface and wsub >= 0.0
+
+
+def element_weights(case: Case, cable, z_nodes) -> tuple[np.ndarray, np.ndarray]:
+    """(weight per unstrained metre (n,) N/m, whether it holds the buoyancy (n,) bool) of the n
+    elements of a cable whose nodes are at heights ``z_nodes`` (n + 1,): the submerged weight
+    for an element with both nodes at or below the still-water level (and w - ρ g A >= 0), the
+    weight in air otherwise (its buoyancy then comes from the Morison pass, docs/theory.md
+    §13.1). A cable wholly in water holds its buoyancy in every element."""
+    mat = case.material_of(cable)
+    z = np.asarray(z_nodes, float)
+    n = z.size - 1
+    water = case.water
+    if water is None or mat.diameter <= 0.0:
+        return np.full(n, mat.weight), np.zeros(n, bool)
+    wsub = mat.weight - water.density * case.gravity * _area(mat.diameter)
+    if buoyancy_in_weight(case, cable):
+        held = np.ones(n, bool)
+    else:
+        held = (np.maximum(z[:-1], z[1:]) <= water.surface) & (wsub >= 0.0)
+    return np.where(held, wsub, mat.weight), held
 
 
 def _area(d: float) -> float:
@@ -119,7 +137,6 @@ class Fluid:
         self.l0 = mesh.L0
         self.gs, self.gw = gauss_s, gauss_w
         mats = [case.material_of(c) for c in case.cables]
-        in_w = [buoyancy_in_weight(case, c) for c in case.cables]
         ce = mesh.cable_of_element
 
         def per(f):
@@ -131,7 +148,14 @@ class Fluid:
         self.cda = per(lambda m: m.drag_axial)
         self.can = per(lambda m: m.added_mass_normal)
         self.caa = per(lambda m: m.added_mass_axial)
-        self.in_weight = np.array([1.0 if in_w[k] else 0.0 for k in ce]).reshape(ne)
+        # the elements whose weight holds their buoyancy (as the mesh decided, from X0)
+        self.in_weight = np.zeros(ne)
+        z0 = mesh.X0[:, 2]
+        for k, cable in enumerate(case.cables):
+            els = np.flatnonzero(ce == k)
+            if els.size:
+                zs = np.concatenate([z0[mesh.conn[els, 0]], z0[mesh.conn[els[-1:], 1]]])
+                self.in_weight[els] = element_weights(case, cable, zs)[1]
         water, air = case.water, case.air
         self.water, self.air = water, air
         self.rho_w = water.density if water is not None else 0.0

@@ -41,6 +41,7 @@ import numpy as np
 from catdae.case import AXES, Case
 from catdae.case.build import MAX_STRAIN
 from catdae.case.frame import gravity_rotation
+from catdae.case.names import cable_of
 from catdae.element.elements import SLACK, Elements
 from catdae.errors import CaseError, ConvergenceError
 
@@ -74,7 +75,7 @@ def initial_lengths(case: Case) -> Case:
     R = gravity_rotation(case.gravity_direction)
     change = first_temperature(case)
     loaded = {x.cable for x in (*case.point_masses, *case.loads) if x.cable is not None}
-    loaded |= {x.node.rpartition(".")[0] for x in (*case.point_masses, *case.loads)
+    loaded |= {cable_of(x.node) for x in (*case.point_masses, *case.loads)
                if x.node is not None and "." in x.node}
     loaded |= {d.cable for d in case.distributed_loads}
     problems = []

@@ -18,9 +18,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from catdae.case import Case
+from catdae.case.names import mesh_node
 from catdae.element.elements import SLACK, Elements, PointLoads
 from catdae.errors import CaseError
-from catdae.model.fluid import line_weight
+from catdae.model.fluid import element_weights, line_weight
 
 AXES = ("x", "y", "z")
 
@@ -192,15 +193,17 @@ def build_mesh(case: Case) -> Mesh:
         pts = _catenary_points(case, cable, a, b, mat.EA, wc, s_nodes)
         ids = [add(cable.ends[0], a, ci, 0.0)]
         for k in range(1, ne):
-            ids.append(add(f"{cable.name}.{k}", pts[k - 1], ci, float(s_nodes[k - 1])))
+            ids.append(add(mesh_node(cable.name, k), pts[k - 1], ci, float(s_nodes[k - 1])))
         ids.append(add(cable.ends[1], b, ci, float(cable.length)))
+        zs = np.concatenate([[a[2]], pts[:, 2], [b[2]]]) if ne > 1 else np.array([a[2], b[2]])
+        w_el = element_weights(case, cable, zs)[0]  # submerged weight where under water
         for k in range(ne):
             conn.append((ids[k], ids[k + 1]))
             cab.append(ci)
-            names.append(f"{cable.name}.{k + 1}")
+            names.append(mesh_node(cable.name, k + 1))
             L0.append(le)
             EA.append(mat.EA)
-            w.append(wc)
+            w.append(float(w_el[k]))
             m.append(mat.mass)
             c.append(mat.damping)
             gp.append(int(cable.gauss_points))

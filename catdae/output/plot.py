@@ -96,6 +96,11 @@ def profile(data, times=None, what: str = "position") -> Figure:
                               gid=f"{cab}|{t}")
             ax_p.plot(pts.sel(axis="x"), pts.sel(axis="y"), marker=".", color=line.get_color(),
                       gid=f"{cab}|{t}")
+            if t is not None and "surface_elevation" in ds and what == "position":
+                # the water surface above the cable's nodes (docs/case-format.md)
+                eta = ds.surface_elevation.sel(time=t, node=nodes)
+                ax_e.plot(pts.sel(axis="x"), ds.attrs.get("water_surface", 0.0) + eta,
+                          ls="--", lw=0.8, color=line.get_color(), gid=f"surface|{cab}|{t}")
     name = var.attrs.get("long_name", what)
     ax_e.set_ylabel(label(var, f"{name}, z"))
     ax_p.set_ylabel(label(var, f"{name}, y"))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from catdae._xr import xr
 from catdae.output import results
+from catdae.output.fluid import with_fluid
 
 
 def dataset(rec) -> xr.Dataset:
@@ -16,8 +17,10 @@ def dataset(rec) -> xr.Dataset:
         "energy_potential": (E[:, 2], "potential of gravity and constant loads"),
         "energy_total": (E.sum(axis=1), "kinetic + strain + potential"),
     }
-    return results.transient_dataset(rec.mesh, rec.times[sl], rec.X[sl], rec.V[sl], rec.A[sl],
-                                     rec.T[sl], rec.R[sl], energy, dict(rec.attrs))
+    ds = results.transient_dataset(rec.mesh, rec.times[sl], rec.X[sl], rec.V[sl], rec.A[sl],
+                                   rec.T[sl], rec.R[sl], energy, dict(rec.attrs))
+    fl = rec.prob.model.fluid  # water and air: surface elevation, fluid velocity
+    return ds if fl is None else with_fluid(ds, fl, rec.times[sl], rec.X[sl])
 
 
 def as_dataset(obj):

@@ -14,6 +14,8 @@ import numpy as np
 
 from catdae._version import __version__
 from catdae.case import AXES, Case, Step
+from catdae.case.names import mesh_node, split_mesh_node
+from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CatdaeError
 
 SETTINGS = ("rtol", "atol", "elements", "gauss_points", "mass_model", "linear_solver",
@@ -30,7 +32,7 @@ _COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "linear_solver": ("", "linear solver requested"),
     "max_order": ("1", "largest BDF order of IDA"),
 }
-_CHOICES = {"mass_model": ("auto", "blended", "consistent", "lumped", "linear"),
+_CHOICES = {"mass_model": MASS_MODEL_NAMES,
             "linear_solver": ("auto", "band", "sparse", "dense")}
 _COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
 _MEMORY_NAMES = {
@@ -190,7 +192,7 @@ def point_labels(case_run: Case, node_names: Sequence[str]) -> list[str | None]:
             fixed = len(case_run.supports.get(name, ())) == len(AXES)
             out.append(None if fixed else name)
             continue
-        cable, _, k = name.rpartition(".")
+        cable, k = split_mesh_node(name)
         out.append(f"{cable}@{Fraction(int(k), counts[cable])}")
     return out
 
@@ -198,7 +200,7 @@ def point_labels(case_run: Case, node_names: Sequence[str]) -> list[str | None]:
 def _mesh_points(case_run: Case) -> set[str]:
     nodes = list(case_run.nodes)
     for c in case_run.cables:
-        nodes += [f"{c.name}.{k}" for k in range(1, c.elements)]
+        nodes += [mesh_node(c.name, k) for k in range(1, c.elements)]
     return {lab for lab in point_labels(case_run, nodes) if lab is not None}
 
 
@@ -216,9 +218,9 @@ def _resolve_response(response: str, case: Case) -> str:
                 raise StudyError(f"response {response!r}: the fraction must be inside (0, 1)")
             return f"{cable}@{f}"
         return response
-    cable, dot, k = response.rpartition(".")
+    cable, k = split_mesh_node(response) or ("", "")
     names = [c.name for c in case.cables]
-    if dot and cable in names and k.isdigit() and 0 < int(k) < case.cable(cable).elements:
+    if cable in names and k.isdigit() and 0 < int(k) < case.cable(cable).elements:
         return f"{cable}@{Fraction(int(k), case.cable(cable).elements)}"
     raise StudyError(f"response {response!r}: expected a case node ({', '.join(case.nodes)}), "
                      "<cable>@<fraction> or a mesh node <cable>.<k> of the case file's mesh")

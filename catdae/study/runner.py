@@ -17,6 +17,7 @@ from catdae._version import __version__
 from catdae._xr import xr
 from catdae.analysis import as_case
 from catdae.case import AXES, Case, Step
+from catdae.case.names import cable_of
 from catdae.errors import CaseError
 from catdae.study.core import (
     _COUNTS,
@@ -173,7 +174,7 @@ def _given_reference(reference, st: Step, case: Case) -> xr.Dataset:
     counts: dict[str, int] = {}
     for n in names:
         if n not in case.nodes:
-            cable = n.rpartition(".")[0]
+            cable = cable_of(n)
             counts[cable] = counts.get(cable, 1) + 1
     ref_case = replace(case, cables=tuple(replace(c, elements=counts.get(c.name, 1))
                                           for c in case.cables))

@@ -111,7 +111,7 @@ def test_missing_case_file_is_one_clear_line(tmp_path, capsys, command):
 def test_invalid_override_is_an_invalid_case(tmp_path, capsys):
     assert main(["run", str(THREE), "--elements", "0", "-o", str(tmp_path / "x.nc")]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "elements: expected an integer >= 1" in err
+    assert err.count("\n") == 1 and "elements: expected a value >= 1, found the integer 0" in err
 
 
 def test_output_in_a_missing_directory(tmp_path, capsys):
