@@ -1,12 +1,39 @@
 """Bad ``[seabed]`` input: exit 2 with one located message (the file, the field, what was
-expected), through ``catdae check`` and ``catdae run`` (tests/unit/test_hostile_cases.py)."""
+expected), through ``catdae check`` and ``catdae run`` (as tests/unit/test_hostile_cases.py)."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import pytest
-from test_hostile_cases import invalid
 
 from scene_toml import cable_scene, static_step, transient_step
+
+
+def invalid(text: str, field: str, expected: str, tmp_path, capsys, *,
+            subprocess_check: bool = True) -> None:
+    """``catdae check`` and ``catdae run`` refuse the case with exit 2 and the one line
+    ``catdae: invalid case: <file>: <field>: ...<expected>...``; nothing is written."""
+    from catdae.cli import main
+
+    f = tmp_path / "case.toml"
+    f.write_text(text)
+    want = f"catdae: invalid case: {f}: {field}: "
+    if subprocess_check:
+        proc = subprocess.run([sys.executable, "-m", "catdae", "check", str(f)], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2, proc.stderr
+        assert proc.stderr.startswith(want) and expected in proc.stderr, proc.stderr
+        assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    out = tmp_path / "out.nc"
+    for args in (["check", str(f)], ["run", str(f), "-o", str(out)]):
+        capsys.readouterr()
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(want) and expected in err, err
+        assert err.count("\n") == 1
+    assert not out.exists()
 
 
 def scene(seabed: str, steps: str | None = None, diameter: bool = True) -> str:
