@@ -12,6 +12,7 @@ Contents
 ``irvine_caughey_frequencies``  linear free-vibration frequencies of a shallow level cable (Hz).
 ``taut_string_frequencies``     frequencies of a weightless taut string (Hz).
 ``grounded_catenary``           elastic catenary from an anchor on a rigid frictionless seabed.
+``level_catenary_midspan``      midspan of a level elastic catenary with a thermal strain.
 
 Formulation of the statics (chosen to differ from the package's: origin at support i, unknowns H and
 the mid-length vertical tension c, two nested scalar root solves with ``brentq`` instead of a Newton
@@ -44,6 +45,7 @@ __all__ = [
     "irvine_caughey_frequencies",
     "taut_string_frequencies",
     "grounded_catenary",
+    "level_catenary_midspan",
 ]
 
 _EPS = np.finfo(float).eps
@@ -419,3 +421,16 @@ def grounded_catenary(span: float, height: float, L0: float, EA: float, w: float
     V = w * ls
     return {"H": H, "V": V, "lying_length": LB, "touchdown_x": LB * (1.0 + H / EA),
             "fairlead_tension": math.hypot(H, V), "anchor_tension": H}
+
+def level_catenary_midspan(L0, EA, w, eps_t, span=None):
+    """(midspan height below the supports (< 0), H) of an elastic catenary of unstrained length
+    L0 between level supports ``span`` apart (default L0) with stretch 1 + eps_t + T/EA
+    (Irvine 1981, §2.2 with a thermal strain): span = H L0/EA + (1 + eps_t) (2H/w)
+    asinh(w L0/(2H)), z_mid = (1 + eps_t) (H - sqrt(H² + (w L0/2)²))/w - w L0²/(8 EA)."""
+    span = L0 if span is None else span
+
+    def gap(H):
+        return H * L0 / EA + (1.0 + eps_t) * 2.0 * H / w * math.asinh(w * L0 / (2.0 * H)) - span
+    H = brentq(gap, 1e-6 * w * L0, 1e3 * w * L0, xtol=1e-13, rtol=1e-15)
+    return ((1.0 + eps_t) * (H - math.hypot(H, 0.5 * w * L0)) / w
+            - w * L0**2 / (8.0 * EA)), H

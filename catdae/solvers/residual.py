@@ -103,7 +103,7 @@ class TransientProblem(ConsistentStart):
         self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
         self._fast_setup()
-        # the seabed's penalty contact (docs/theory.md §14); None for a scene without one
+        # the seabed's penalty contact (docs/theory.md §15); None for a scene without one
         self.seabed = SeabedContact.of_step(model)
 
     def _fast_setup(self) -> None:
@@ -174,7 +174,7 @@ class TransientProblem(ConsistentStart):
         self._buffers_at = (t, np.array(y[0::2], copy=True))
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
-        if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §14)
+        if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §15)
             res[1::2] -= self.seabed.forces(self._Xb.reshape(-1, 3),
                                             self._Vb.reshape(-1, 3)).ravel()[self._fidx]
         return True
@@ -334,7 +334,7 @@ class TransientProblem(ConsistentStart):
             pat = self.model.pattern
             kdata = kdata + pat.assemble(kx)
             vdata = vdata + pat.assemble(cj * ma + kv)
-        if self.seabed is not None:  # docs/theory.md §14: -∂f/∂q, -∂f/∂v of the contact
+        if self.seabed is not None:  # docs/theory.md §15: -∂f/∂q, -∂f/∂v of the contact
             V, _ = self.full_vectors(t, y[1::2], yp[1::2])
             kdata, vdata = self.seabed.add_derivatives(kdata, vdata, self._conf_X(), V)
         sel = self.ff_sel
@@ -393,7 +393,7 @@ class TransientProblem(ConsistentStart):
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
-        if self.seabed is not None:  # the contact springs' energy (docs/theory.md §14)
+        if self.seabed is not None:  # the contact springs' energy (docs/theory.md §15)
             gravity += self.seabed.energy(X.reshape(-1, 3))
         return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
