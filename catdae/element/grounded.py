@@ -1,4 +1,4 @@
-"""The catenary element resting on a rigid, frictionless, flat seabed (docs/theory.md §15).
+"""The catenary element resting on a rigid, frictionless, flat seabed (docs/theory.md §17).
 
 A seabed at height z_b supports the part of an element that lies on it: there the cable is
 straight and horizontal, its tension vector is (Hx, Hy, 0), constant, and the seabed carries its

@@ -1,4 +1,4 @@
-"""The seabed in a step's model (docs/theory.md §15).
+"""The seabed in a step's model (docs/theory.md §17).
 
 Two descriptions of one flat bottom at height z_b:
 
@@ -35,7 +35,7 @@ class GroundedState(ElementState):
     @property
     def stiffness6(self) -> np.ndarray:
         """∂(r_i, r_j)/∂(u_i, u_j) = [[P_i K, -P_i K], [-P_j K, P_j K]], P = diag(1, 1, slope):
-        the end forces of a lying end have no vertical part (docs/theory.md §15.3)."""
+        the end forces of a lying end have no vertical part (docs/theory.md §17.3)."""
         k = self.K
         p0 = np.ones((k.shape[0], 3, 1))
         p1 = np.ones((k.shape[0], 3, 1))
@@ -173,7 +173,7 @@ class GroundedModel(Model):
 
 
 class SeabedContact:
-    """Penalty contact of the free nodes with the seabed (docs/theory.md §15.5).
+    """Penalty contact of the free nodes with the seabed (docs/theory.md §17.5).
 
     Node k has the contact area a_k = Σ_e ½ L0_e d_e of its elements (d the contact width,
     the materials' ``diameter``). Below the seabed (δ = z_b - z > 0) the seabed pushes it up

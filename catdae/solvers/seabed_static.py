@@ -1,4 +1,4 @@
-"""Static equilibrium on a rigid, frictionless seabed (docs/theory.md §15.4).
+"""Static equilibrium on a rigid, frictionless seabed (docs/theory.md §17.4).
 
 The nodes resting on the seabed are an active set: they are held at z_b (a roller in z) and
 the elements with an end on the seabed take their grounded relations (catdae.model.seabed,
@@ -160,8 +160,8 @@ def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str,
 
 
 def solve_static_on_seabed(model: Model, X, h0=None, t: float = 0.0, load_steps: int = 1):
-    """A static step of a scene with a seabed: on the rigid seabed (no ``stiffness``, §15.4)
-    or on its contact springs (§15.5). Returns (solution, the model whose tensions and
+    """A static step of a scene with a seabed: on the rigid seabed (no ``stiffness``, §17.4)
+    or on its contact springs (§17.5). Returns (solution, the model whose tensions and
     reactions are the solution's, per-cable seabed_length and touchdown)."""
     sb = model.case.seabed
     if sb.stiffness is None:

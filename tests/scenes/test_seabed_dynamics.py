@@ -1,4 +1,4 @@
-"""The seabed's penalty contact in modal and transient steps (docs/theory.md §15): its part of
+"""The seabed's penalty contact in modal and transient steps (docs/theory.md §17): its part of
 IDA's iteration matrix against finite differences, energy conservation of an undamped,
 frictionless contact and loss with damping and friction, the penetration of a lying chain,
 and the bundled mooring case at a cheap setting."""

@@ -1,4 +1,4 @@
-"""Statics on a rigid, frictionless seabed (docs/theory.md §15): a mooring line from an anchor
+"""Statics on a rigid, frictionless seabed (docs/theory.md §17): a mooring line from an anchor
 on the seabed to a fairlead is the closed-form grounded elastic catenary at any mesh.
 
 Independent references: ``reference.grounded_catenary`` (nested root solves from the textbook
@@ -141,7 +141,7 @@ def test_free_fairlead_finds_the_grounded_equilibrium(elements):
     too close to the anchor and 30 m too low: Newton and the contact set (nodes joining and
     leaving the seabed) bring it to the closed form's fairlead position to 1e-6 relative.
     (A dead load on a free fairlead is a hard start: from some starts, e.g. 10 m too far out,
-    the 10-element line does not converge; docs/theory.md §15.4.)"""
+    the 10-element line does not converge; docs/theory.md §17.4.)"""
     x, length = CHAINS[200]
     ref = grounded_catenary(x, 200.0, length, EA, W_SUB)
     text = chain_toml(200, elements, fairlead=(20.0, 0.0, -30.0)).replace(
