@@ -164,7 +164,7 @@ class GroundedModel(Model):
 
     def reactions(self, state, t: float, X: np.ndarray | None = None) -> np.ndarray:
         """Force of the supports on the cable (the seabed's point forces are not reactions)."""
-        r = self.internal_force(state) - self.nodal_load(t)
+        r = self.internal_force(state, X) - self.nodal_load(t)
         if self.fluid is not None and X is not None:
             r += self.fluid.static(X)[0]
         out = np.full(self.n_dof, np.nan)
@@ -347,17 +347,19 @@ class ContactModel(Model):
         st = self.base.element_state(X, h0)
         return ContactState(st.h, st.F, st.K, st.iterations, st.status, np.array(X))
 
-    def internal_force(self, state) -> np.ndarray:
-        return self.base.internal_force(state) - self.contact.forces(state.X).ravel()
+    def internal_force(self, state, X: np.ndarray | None = None) -> np.ndarray:
+        X = state.X if X is None else X
+        return self.base.internal_force(state, X) - self.contact.forces(X).ravel()
 
-    def stiffness_data(self, state) -> np.ndarray:
-        data = self.base.stiffness_data(state)
-        kq, _ = self.contact.derivatives(state.X)
+    def stiffness_data(self, state, X: np.ndarray | None = None) -> np.ndarray:
+        X = state.X if X is None else X
+        data = self.base.stiffness_data(state, X)
+        kq, _ = self.contact.derivatives(X)
         np.add.at(data, self._slots.ravel(), kq.ravel())
         return data
 
-    def stiffness(self, state):
-        return self.pattern.matrix(self.stiffness_data(state))
+    def stiffness(self, state, X: np.ndarray | None = None):
+        return self.pattern.matrix(self.stiffness_data(state, X))
 
     def summary(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Per cable, at node resolution: unstrained length resting on the seabed (elements

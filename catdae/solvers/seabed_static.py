@@ -64,7 +64,10 @@ def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, suppo
         gm = GroundedModel(model, contact, contact | support_on, zb)
         sol = solve_static(gm, X, h, t=t, load_steps=load_steps)
         X, h = sol.X, sol.state.h
-        rz = (gm.internal_force(sol.state) - gm.nodal_load(t)).reshape(-1, 3)[:, 2]
+        r = gm.internal_force(sol.state, X) - gm.nodal_load(t)
+        if gm.fluid is not None:  # the fluid's static forces, as in the static residual
+            r = r + gm.fluid.static(X)[0]
+        rz = r.reshape(-1, 3)[:, 2]  # what the seabed must push up with at each node
         below = ~fixed_z & ~contact & (X[:, 2] < zb - ztol)
         pulling = contact & (rz < -1e-9 * fscale)
         if not below.any() and not pulling.any():
