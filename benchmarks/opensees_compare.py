@@ -205,6 +205,7 @@ def main(argv=None) -> None:
 
     sys.path.insert(0, str(HERE))
     import transient_speed as ts
+    from bench_scene import opensees_job
 
     duration = args.duration
     tols = [float(x) for x in args.tols.split(",")]
@@ -260,15 +261,7 @@ def main(argv=None) -> None:
 
     def ops_job(ne: int, tree_ne) -> dict:
         """The OpenSees model of the ne-element cable, nodes at catdae's static equilibrium."""
-        st = tree_ne["initial"].ds
-        nodes = [str(n) for n in st.node.values]
-        order = {n: k for k, n in enumerate(nodes)}
-        chain = ["A"] + [f"c.{k}" for k in range(1, ne)] + ["B"]
-        conn = [[order[chain[k]], order[chain[k + 1]]] for k in range(ne)]
-        return {"X": st.position.values.tolist(), "conn": conn,
-                "supports": [order["A"], order["B"]], "mid": order[f"c.{ne // 2}"],
-                "EA": 1.0e8, "weight": -100.0, "rho": 100.0 / 9.81, "L0e": [102.0 / ne] * ne,
-                "error_tol": ERROR_TOL, "duration": duration, "newton_tol": 1e-10, "ne": ne}
+        return opensees_job(tree_ne["initial"].ds, ne, error_tol=ERROR_TOL, duration=duration)
 
     job16 = ops_job(16, tree)
 

@@ -43,60 +43,19 @@ sys.path.insert(0, str(HERE))
 
 import opensees_compare as oc  # noqa: E402
 import transient_speed as ts  # noqa: E402
+from bench_scene import hundred_metre_cable, opensees_job  # noqa: E402
 
 import catdae  # noqa: E402
 from catdae.case import case_from_dict  # noqa: E402
 
 DURATION = 10.0
 TARGETS = (1e-2, 2e-3)  # m
-CASE = """
-title = "Issue 11 benchmark: 100 m cable, end B moving along the span"
-gravity = 9.81
-
-[materials.m]
-EA = 1.0e8
-mass = {mass!r}
-weight = 100.0
-
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [100.0, 0.0, 0.0]
-
-[supports]
-A = "pinned"
-B = "pinned"
-
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 102.0
-elements = {elements}
-gauss_points = 3
-
-[[support_motions]]
-node = "B"
-x = {{ kind = "cosine", amplitude = -0.05, frequency = 0.5, offset = 0.05 }}
-
-[[steps]]
-kind = "static"
-name = "initial"
-
-[[steps]]
-kind = "transient"
-name = "motion"
-duration = {duration!r}
-output_interval = 0.01
-rtol = {rtol!r}
-atol = {atol!r}
-mass_model = "{mass_model}"
-"""
-
-
 def case_text(n: int, rtol: float, mass_model: str = "blended", duration: float = DURATION,
               max_order: str | int = "auto"):
-    text = CASE.format(mass=100.0 / 9.81, elements=n, duration=duration, rtol=rtol,
-                       atol=rtol * 1e-2, mass_model=mass_model)
+    text = hundred_metre_cable(
+        title="Issue 11 benchmark: 100 m cable, end B moving along the span", elements=n,
+        node="B", axis="x", amplitude=0.05, duration=duration, output_interval=0.01, rtol=rtol,
+        atol=rtol * 1e-2, mass_model=mass_model)
     if max_order != "auto":
         text = text.replace(f'mass_model = "{mass_model}"',
                             f'mass_model = "{mass_model}"\nmax_order = {int(max_order)}')
@@ -145,16 +104,8 @@ def ops_job(n: int) -> dict:
     """The OpenSees model on n elements, its nodes at catdae's static equilibrium."""
     tree = catdae.run(case_from_dict(tomllib.loads(case_text(n, 1e-4, duration=0.01))),
                       progress=False)
-    st = tree["initial"].ds
-    nodes = [str(v) for v in st.node.values]
-    order = {v: k for k, v in enumerate(nodes)}
-    chain = ["A"] + [f"c.{k}" for k in range(1, n)] + ["B"]
-    conn = [[order[chain[k]], order[chain[k + 1]]] for k in range(n)]
-    return {"X": st.position.values.tolist(), "conn": conn,
-            "supports": [order["A"], order["B"]], "mid": order[f"c.{n // 2}"],
-            "motion": [order["B"], 1, 0.05],
-            "EA": 1.0e8, "weight": -100.0, "rho": 100.0 / 9.81, "L0e": [102.0 / n] * n,
-            "error_tol": oc.ERROR_TOL, "duration": DURATION, "newton_tol": 1e-10, "ne": n}
+    return opensees_job(tree["initial"].ds, n, motion=("B", 1, 0.05), error_tol=oc.ERROR_TOL,
+                        duration=DURATION)
 
 
 def run_ops(job: dict, dt: float, env: dict) -> dict:

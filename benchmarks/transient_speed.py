@@ -43,6 +43,9 @@ import numpy as np  # noqa: E402
 import catdae  # noqa: E402
 from catdae.case import case_from_dict  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_scene import hundred_metre_cable  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE1 = ROOT / "cases" / "example1_free_vibration.toml"
 TOLS = (1e-4, 1e-6, 1e-8)
@@ -51,53 +54,12 @@ REF_RTOL = 1e-10
 # each run is kept under about a minute)
 DURATIONS = {10: 2.0, 50: 1.0, 200: 0.1, 1000: 0.02, 2000: 0.01}
 
-CABLE_TOML = """
-title = "Benchmark: 100 m cable, one end moving vertically"
-gravity = 9.81
-
-[materials.m]
-EA = 1.0e8
-mass = {mass!r}
-weight = 100.0
-
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [100.0, 0.0, 0.0]
-
-[supports]
-A = "pinned"
-B = "pinned"
-
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 102.0
-elements = {elements}
-gauss_points = 3
-
-[[support_motions]]
-node = "A"
-z = {{ kind = "cosine", amplitude = -0.5, frequency = 0.5, offset = 0.5 }}
-
-[[steps]]
-kind = "static"
-name = "initial"
-
-[[steps]]
-kind = "transient"
-name = "motion"
-duration = {duration!r}
-output_interval = {output_interval!r}
-rtol = 1e-6
-atol = 1e-8
-"""
-
-
 def cable_dict(elements: int = 16, duration: float = 10.0, output_interval: float = 0.01,
                **step) -> dict:
-    text = CABLE_TOML.format(mass=100.0 / 9.81, elements=elements, duration=duration,
-                             output_interval=output_interval)
+    text = hundred_metre_cable(title="Benchmark: 100 m cable, one end moving vertically",
+                               elements=elements, node="A", axis="z", amplitude=0.5,
+                               duration=duration, output_interval=output_interval, rtol=1e-6,
+                               atol=1e-8)
     d = tomllib.loads(text)
     d["steps"][1].update(step)
     return d

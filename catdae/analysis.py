@@ -22,7 +22,8 @@ from catdae.interrupts import deferred
 from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
-from catdae.output import results
+from catdae.model.span import span_quantities
+from catdae.output import engineering, results
 from catdae.output.transient import as_dataset
 from catdae.solvers.modal import solve_modal
 from catdae.solvers.static import solve_static
@@ -83,7 +84,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 model = Model(local, mesh.heated(local, temperature), absent,
                               mass_model=step.mass_model, kind=step.kind)
                 ds = _run_step(step, model, state, writer, progress)
-            ds = rotate_back(ds, rotation)
+            ds = engineering_results(step, rotate_back(ds, rotation), case, groups,
+                                     temperature)
         except KeyboardInterrupt as exc:
             # keep what the finished steps (and a transient, up to the interrupt) computed;
             # the interrupt itself goes on
@@ -185,12 +187,32 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
-    return results.static_dataset(
+    ds = results.static_dataset(
         model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t, sol.X),
         {"iterations": sol.iterations, "residual_norm": sol.residual_norm,
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),
     )
+    return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
+                                  engineering.rated_strengths(model.case, model.mesh.cable_names))
+
+
+def engineering_results(step: Step, ds: xr.Dataset, case: Case,
+                        groups: dict[str, xr.Dataset], temperature) -> xr.Dataset:
+    """A step's group (in the case's axes) with, for a uniform temperature change, the attrs
+    ``temperature_change`` (K) and, with the case's ``reference_temperature``, ``temperature``;
+    a transient group also with its envelopes and, after a ``jump_reference`` static step,
+    the jump of each cable (catdae.output.engineering)."""
+    if not isinstance(temperature, dict) and not hasattr(temperature, "items"):
+        ds = ds.assign_attrs(temperature_change=float(temperature))
+        if case.reference_temperature is not None:
+            ds = ds.assign_attrs(temperature=case.reference_temperature + float(temperature))
+    if step.kind != "transient":
+        return ds
+    ref = groups.get(step.jump_reference) if step.jump_reference else None
+    if ref is not None:
+        ds = ds.assign_attrs(jump_reference=step.jump_reference)
+    return engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
 
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:

@@ -21,7 +21,8 @@ from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CaseError, CatdaeError, OutputError
 from catdae.interrupts import signals_as_interrupts
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes")  # catdae.output.plot.WHAT
+# catdae.output.plot.WHAT
+WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
 DEFAULT_CASE = "example1_free_vibration.toml"
 
@@ -55,8 +56,9 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("--step", nargs="+", metavar="NAME", help="steps to plot (default: all)")
     pl.add_argument("--what", nargs="+", choices=WHAT, metavar="WHAT",
                     help=f"figures: {', '.join(WHAT)} (default: all a step can make)")
-    pl.add_argument("--node", help="node of history and spectrum (default: the free node "
-                    "that moves most)")
+    pl.add_argument("--node", help="node of history and spectrum: a node name, <cable>@<p/q> "
+                    "(fraction of the cable's length, e.g. main@1/2) or <cable>@s=<m> (arc "
+                    "length); default: the free node that moves most")
     pl.add_argument("--times", nargs="+", type=float, metavar="T",
                     help="times of profile and tension, s (nearest outputs; default: 5)")
     ex = sub.add_parser("export", help="export a results file for other tools")
@@ -144,14 +146,12 @@ def _run(args) -> int:
     except OutputError as exc:  # judged before any work: a usage error
         print(f"catdae: {exc}", file=sys.stderr)
         return 2
-    from catdae.element.elements import kernels_cached
+    from catdae.progress import announce_compiling
 
-    if not kernels_cached():
-        print("catdae: compiling the element kernels for this machine (once after install or "
-              "upgrade, about a minute)...", file=sys.stderr, flush=True)
     try:
-        tree = run(case, output=out, progress=args.progress, rtol=args.rtol, atol=args.atol,
-                   elements=args.elements, mass_model=args.mass_model)
+        with announce_compiling():  # whenever numba compiles, the first time is announced
+            tree = run(case, output=out, progress=args.progress, rtol=args.rtol,
+                       atol=args.atol, elements=args.elements, mass_model=args.mass_model)
     except CaseError:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:
@@ -212,12 +212,13 @@ def summary(tree) -> str:
         ds = node.to_dataset()
         kind = ds.attrs.get("kind", "")
         if kind == "static":
-            lines.append(f"[{name}] static: {ds.attrs.get('iterations')} Newton iterations, "
-                         f"residual {ds.attrs.get('residual_norm', 0):.2e} N")
+            hot = (f" at {ds.attrs['temperature']:.6g} deg" if "temperature" in ds.attrs
+                   else "")
+            lines.append(f"[{name}] static{hot}: {ds.attrs.get('iterations')} Newton "
+                         f"iterations, residual {ds.attrs.get('residual_norm', 0):.2e} N")
             lines.extend(_cable_lines(ds))
         elif kind == "modal":
-            f = ", ".join(f"{v:.4g}" for v in ds.frequency.values[:10])
-            lines.append(f"[{name}] modal: frequencies (Hz): {f}")
+            lines.extend(_mode_lines(name, ds))
         elif kind == "transient":
             a = ds.attrs
             lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
@@ -233,9 +234,59 @@ def summary(tree) -> str:
             lines.append(f"    largest motion of a free node at {node}: "
                          f"{float(mag.sel(node=node).max()):.4g} m; "
                          f"max tension {float(ds.tension.max()):.6g} N")
+            lines.extend(_jump_lines(ds))
             if a.get("note"):
                 lines.append(f"    note: {a['note']}")
     return "\n".join(lines)
+
+
+def _mode_lines(name: str, ds) -> list[str]:
+    """Every mode of a modal step: its frequency and labels (plane, symmetry)."""
+    out = [f"[{name}] modal: {ds.mode.size} modes"]
+    for k, mode in enumerate(ds.mode.values):
+        labels = ", ".join(str(ds[v].values[k]) for v in ("plane", "symmetry") if v in ds)
+        out.append(f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
+                   + (f", {labels}" if labels else ""))
+    return out
+
+
+def _jump_lines(ds) -> list[str]:
+    """Per cable of a transient: its largest rise above the jump_reference step, the largest
+    tension as a percentage of the rated strength (catdae.output.engineering)."""
+    out = []
+    for k, cab in enumerate(ds.cable.values if "cable" in ds.coords else ()):
+        parts = []
+        if "jump_height" in ds:
+            parts.append(f"jump {float(ds.jump_height.values[k]):.6g} m above step "
+                         f"'{ds.attrs.get('jump_reference', '')}' at t = "
+                         f"{float(ds.jump_time.values[k]):.6g} s, s = "
+                         f"{float(ds.jump_s.values[k]):.6g} m")
+        if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
+            parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % "
+                         "of rated strength")
+        if "clearance_time" in ds:
+            parts.append(f"least clearance {float(ds.clearance.values[k]):.6g} m at t = "
+                         f"{float(ds.clearance_time.values[k]):.6g} s")
+        if parts:
+            out.append(f"    cable {cab}: " + "; ".join(parts))
+    return out
+
+
+def _span_lines(ds, k: int) -> list[str]:
+    """The span quantities of cable k (catdae.output.engineering), when the group has them."""
+    if "sag_midspan" not in ds:
+        return []
+    parts = [f"sag at midspan {float(ds.sag_midspan.values[k]):.6g} m",
+             f"at the lowest point {float(ds.sag_lowest_point.values[k]):.6g} m below the lower "
+             "end",
+             f"swing angle {float(ds.swing_angle.values[k]):.4g} deg"]
+    if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
+        parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % of "
+                     "rated strength")
+    if "clearance" in ds:
+        parts.append(f"clearance above the ground {float(ds.clearance.values[k]):.6g} m at "
+                     f"s = {float(ds.clearance_s.values[k]):.6g} m")
+    return ["      " + "; ".join(parts)]
 
 
 def _cable_lines(ds) -> list[str]:
@@ -245,12 +296,18 @@ def _cable_lines(ds) -> list[str]:
     out = []
     for k, cab in enumerate(ds.cable.values):
         t_i, t_j = (float(v) for v in ds.cable_end_tension.values[k])
+        first = str(ds.element_node.values[ds.element_cable.values == cab][0, 0])
         line = (f"    cable {cab}: end tensions {t_i:.6g} N, {t_j:.6g} N; horizontal tension "
-                f"{float(ds.horizontal_tension.values[k]):.6g} N; sag "
-                f"{float(ds.sag.values[k]):.6g} m")
+                f"{float(ds.horizontal_tension.values[k]):.6g} N at {first} (includes the part "
+                "across the chord)")
+        if "horizontal_tension_along_chord" in ds:
+            line += (f", along the chord "
+                     f"{float(ds.horizontal_tension_along_chord.values[k]):.6g} N")
+        line += f"; sag {float(ds.sag.values[k]):.6g} m"
         if "unstrained_length" in ds:
             line += f"; L0 {float(ds.unstrained_length.values[k]):.9g} m"
         out.append(line)
+        out.extend(_span_lines(ds, k))
     return out
 
 

@@ -11,6 +11,7 @@ Contents
 ``irvine_symmetric_roots``      roots of Irvine & Caughey's symmetric in-plane frequency equation.
 ``irvine_caughey_frequencies``  linear free-vibration frequencies of a shallow level cable (Hz).
 ``taut_string_frequencies``     frequencies of a weightless taut string (Hz).
+``level_catenary_midspan``      midspan of a level elastic catenary with a thermal strain.
 
 Formulation of the statics (chosen to differ from the package's: origin at support i, unknowns H and
 the mid-length vertical tension c, two nested scalar root solves with ``brentq`` instead of a Newton
@@ -42,6 +43,7 @@ __all__ = [
     "irvine_symmetric_roots",
     "irvine_caughey_frequencies",
     "taut_string_frequencies",
+    "level_catenary_midspan",
 ]
 
 _EPS = np.finfo(float).eps
@@ -372,3 +374,17 @@ def piecewise_catenary(span: float, dz: float, EA: float, pieces) -> dict:
         raise RuntimeError(f"piecewise catenary residual {residual:.3e} m too large")
     return {"H": H, "V_i": V, "V_j": V + float((w * L).sum()),
             "position": lambda s: position(s, H, V), "residual": residual}
+
+
+def level_catenary_midspan(L0, EA, w, eps_t, span=None):
+    """(midspan height below the supports (< 0), H) of an elastic catenary of unstrained length
+    L0 between level supports ``span`` apart (default L0) with stretch 1 + eps_t + T/EA
+    (Irvine 1981, §2.2 with a thermal strain): span = H L0/EA + (1 + eps_t) (2H/w)
+    asinh(w L0/(2H)), z_mid = (1 + eps_t) (H - sqrt(H² + (w L0/2)²))/w - w L0²/(8 EA)."""
+    span = L0 if span is None else span
+
+    def gap(H):
+        return H * L0 / EA + (1.0 + eps_t) * 2.0 * H / w * math.asinh(w * L0 / (2.0 * H)) - span
+    H = brentq(gap, 1e-6 * w * L0, 1e3 * w * L0, xtol=1e-13, rtol=1e-15)
+    return ((1.0 + eps_t) * (H - math.hypot(H, 0.5 * w * L0)) / w
+            - w * L0**2 / (8.0 * EA)), H

@@ -1,4 +1,6 @@
-"""TOML text of the one-cable scene that many tests run: cable ``c`` from node A to node B.
+"""TOML text of the test scenes: one builder for every scene a test writes (and the shared
+scenes themselves, e.g. ``long_transient``). Most are the one-cable scene, cable ``c`` from node
+A to node B.
 
 ``cable_scene`` writes, in this order and without blank lines::
 
@@ -18,11 +20,23 @@ holds ``=`` (e.g. ``'B = ["y", "z"]'``) is written as it stands.
 
 ``static_step``, ``modal_step`` and ``transient_step`` give the ``[[steps]]`` blocks most scenes
 end with.
+
+Scenes of several cables, or with other node names, are written by ``scene`` in the same layout
+(``head`` keys, ``[materials.*]``, ``[nodes]``, ``[supports]``, then the ``[[cables]]`` blocks,
+``extra`` and ``steps``); ``cable_scene`` is ``scene`` with one cable from A to B. The blocks of
+the arrays of tables are written by ``table`` (one ``key = value`` line per field given, in the
+order given, ``None`` left out) and its named forms ``cable``, ``point_mass``, ``load``,
+``distributed_load``, ``support_motion`` and ``step``. Values: a bool as ``true``/``false``, an
+integer as such, any other number as ``num`` writes it, a string quoted (``raw(...)`` as it
+stands), a sequence as an array and a mapping as an inline table.
+
+Shared scenes: ``long_transient`` (a transient that is always interrupted before its end).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import numbers
+from collections.abc import Callable, Mapping, Sequence
 
 
 def _float(x) -> str:
@@ -34,32 +48,105 @@ def _block(text: str) -> str:
     return text if not text or text.endswith("\n") else text + "\n"
 
 
+class raw(str):  # noqa: N801 (used like a function: raw("4.696e8"))
+    """A value written into the TOML as it stands (a number already written, an expression)."""
+
+
+def value(v, num: Callable[[object], str] = _float) -> str:
+    """``v`` as a TOML value (see the module docstring)."""
+    if isinstance(v, raw):
+        return str(v)
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, numbers.Integral):
+        return str(int(v))
+    if isinstance(v, numbers.Real):
+        return num(v)
+    if isinstance(v, str):
+        return '"' + v + '"'
+    if isinstance(v, Mapping):
+        return "{ " + ", ".join(f"{k} = {value(x, num)}" for k, x in v.items()) + " }"
+    return "[" + ", ".join(value(x, num) for x in v) + "]"
+
+
+def _lines(fields: Mapping, num: Callable[[object], str] = _float) -> list[str]:
+    return [f"{k} = {value(v, num)}" for k, v in fields.items() if v is not None]
+
+
+def table(array: str, /, **fields) -> str:
+    """One ``[[array]]`` block: a ``key = value`` line per field that is not ``None``."""
+    return "".join(line + "\n" for line in [f"[[{array}]]", *_lines(fields)])
+
+
+def cable(name: str, ends=("A", "B"), material: str = "m", length=None, elements=None,
+          **more) -> str:
+    """A ``[[cables]]`` block (``more``: gauss_points, form, ... in the order given)."""
+    return table("cables", name=name, ends=list(ends), material=material, length=length,
+                 elements=elements, **more)
+
+
+_cable = cable  # for cable_scene, whose argument ``cable`` is the cable's name
+
+
+def point_mass(name: str, mass, *, node=None, cable=None, s=None, **more) -> str:
+    """A ``[[point_masses]]`` block: at a node, or at arc length ``s`` along a cable."""
+    return table("point_masses", name=name, node=node, cable=cable, s=s, mass=mass, **more)
+
+
+def load(name: str, force, *, node=None, cable=None, s=None, **more) -> str:
+    """A ``[[loads]]`` block: a force at a node, or at arc length ``s`` along a cable (``more``:
+    time, active, ...)."""
+    return table("loads", name=name, node=node, cable=cable, s=s, force=force, **more)
+
+
+def distributed_load(cable: str, load, **more) -> str:
+    """A ``[[distributed_loads]]`` block."""
+    return table("distributed_loads", cable=cable, load=load, **more)
+
+
+def support_motion(node: str, **axes) -> str:
+    """A ``[[support_motions]]`` block: ``axes`` maps x, y, z to time functions (mappings)."""
+    return table("support_motions", node=node, **axes)
+
+
+def step(kind: str, /, name: str | None = None, **fields) -> str:
+    """A ``[[steps]]`` block of any kind (``name`` left out when ``None``)."""
+    return table("steps", kind=kind, name=name, **fields)
+
+
+def scene(*, nodes: Mapping[str, Sequence], cables: str | Sequence[str],
+          materials: Mapping[str, Mapping], supports: Sequence[str] = ("A", "B"),
+          head: Mapping | None = None, extra: str = "", steps: str = "",
+          num: Callable[[object], str] = _float) -> str:
+    """A scene of any cables, as TOML text (see the module docstring for the layout).
+
+    ``head``: the top-level keys (title, gravity, source, ...); ``materials``: name -> fields;
+    ``supports``: node names (pinned) or whole lines; ``cables``: ``cable(...)`` blocks."""
+    lines = _lines(head or {}, num)
+    for name, fields in materials.items():
+        lines += [f"[materials.{name}]", *_lines(fields, num)]
+    lines += ["[nodes]", *(f"{n} = {value(list(x), num)}" for n, x in nodes.items()),
+              "[supports]"]
+    lines += [s if "=" in s else f'{s} = "pinned"' for s in supports]
+    blocks = cables if isinstance(cables, str) else "".join(cables)
+    return "\n" + "".join(line + "\n" for line in lines) + blocks + _block(extra) + _block(steps)
+
+
 def cable_scene(*, B, L0, EA, mass, elements: int | None = None, A=(0.0, 0.0, 0.0),
                 weight=None, gauss_points: int | None = None,
                 supports: Sequence[str] = ("A", "B"), title: str | None = None, gravity=None,
                 material: str = "m", cable: str = "c", extra: str = "", steps: str = "",
                 num: Callable[[object], str] = _float) -> str:
     """One cable from node A to node B, as TOML text (see the module docstring for the layout)."""
-    lines = []
-    if title is not None:
-        lines.append(f'title = "{title}"')
-    if gravity is not None:
-        lines.append(f"gravity = {num(gravity)}")
-    lines += [f"[materials.{material}]", f"EA = {num(EA)}", f"mass = {num(mass)}"]
-    if weight is not None:
-        lines.append(f"weight = {num(weight)}")
-    lines += ["[nodes]",
-              "A = [" + ", ".join(num(a) for a in A) + "]",
-              "B = [" + ", ".join(num(b) for b in B) + "]",
-              "[supports]"]
-    lines += [s if "=" in s else f'{s} = "pinned"' for s in supports]
-    lines += ["[[cables]]", f'name = "{cable}"', 'ends = ["A", "B"]',
-              f'material = "{material}"', f"length = {num(L0)}"]
-    if elements is not None:
-        lines.append(f"elements = {elements}")
-    if gauss_points is not None:
-        lines.append(f"gauss_points = {gauss_points}")
-    return "\n" + "".join(line + "\n" for line in lines) + _block(extra) + _block(steps)
+    def n(x):
+        return None if x is None else raw(num(x))
+
+    return scene(head={"title": title, "gravity": n(gravity)},
+                 materials={material: {"EA": n(EA), "mass": n(mass), "weight": n(weight)}},
+                 nodes={"A": [n(a) for a in A], "B": [n(b) for b in B]}, supports=supports,
+                 cables=_cable(cable, ("A", "B"), material, n(L0), elements,
+                               gauss_points=gauss_points),
+                 extra=extra, steps=steps, num=num)
 
 
 def static_step(name: str = "st") -> str:
@@ -81,3 +168,15 @@ def transient_step(name: str, duration, output_interval, *, rtol, atol, remove=N
     return (f'[[steps]]\nkind = "transient"\nname = "{name}"\n{rm}'
             f"duration = {num(duration)}\noutput_interval = {num(output_interval)}\n"
             f"rtol = {num(rtol)}\natol = {num(atol)}\n" + _block(extra))
+
+
+def long_transient(duration=1000.0) -> str:
+    """A weightless taut cable (chord 10 m, 10 % strain, 2 elements) pushed sideways at c.1 by
+    1 N (load "push") in the static step "static", then released for ``duration`` seconds in the
+    transient "dyn" (about 200 s of wall time per 1000 s simulated: a run of it is always
+    interrupted long before its end)."""
+    return cable_scene(
+        B=(10.0, 0.0, 0.0), L0=10.0 / 1.1, EA=1e4, mass=2.0, weight=0.0, elements=2,
+        extra=load("push", [0.0, 1.0, 0.0], node="c.1"),
+        steps=static_step("static") + transient_step("dyn", duration, 0.01, rtol=1e-6,
+                                                     atol=1e-9, remove=["push"]))

@@ -22,6 +22,7 @@ from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
+from catdae.case.ground import _GroundPass
 from catdae.case.limits import size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from catdae.case.model import (
@@ -41,7 +42,7 @@ from catdae.case.schema import (
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
+class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _GroundPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -109,6 +110,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
         distributed = self.distributed(top.distributed_loads, cables)
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
+        self.reference_temperature = top.reference_temperature
+        ground = self.ground(top.ground, self.gravity_direction)
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
         self.fluid_lines(top.materials, water, air)
@@ -125,6 +128,7 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
             steps=tuple(steps), water=water, air=air, path=self.path, text=text, name=name,
+            reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -190,7 +194,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass):
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
-                                    float(m.thermal_expansion), **line_fluid(m))
+                                    float(m.thermal_expansion), **line_fluid(m),
+                                    rated_strength=m.rated_strength)
         return out
 
     def nodes(self, raw: dict[str, Any]) -> dict[str, tuple[float, float, float]]:

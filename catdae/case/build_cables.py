@@ -251,6 +251,8 @@ class _CablesPass:
     def coverage(self, v: Any, where: tuple, cable: Cable) -> tuple[float, float] | None:
         """``(from_s, to_s)`` of a distributed load, within its cable and in order."""
         length = cable.length
+        if length is None:
+            return self.found_length_coverage(v, where, cable)
         a = 0.0 if v.from_s is None else float(v.from_s)
         b = length if v.to_s is None else float(v.to_s)
         ok = True
@@ -264,6 +266,21 @@ class _CablesPass:
                          f"from_s <= s <= to_s), found from_s = {a:g} and to_s = {b:g}")
             ok = False
         return (a, b) if ok else None
+
+    def found_length_coverage(self, v: Any, where: tuple,
+                              cable: Cable) -> tuple[float, float] | None:
+        """A cable whose length form-finding finds is covered whole: ``(0, inf)``, the mesh
+        clips it to the length found. Arc lengths are not known in advance, so a part
+        coverage (``from_s``, ``to_s``) is refused."""
+        ok = True
+        for key in ("from_s", "to_s"):
+            if getattr(v, key) is not None:
+                self.problem(where + (key,), f"cable {cable.name!r} has its length found by "
+                             "form-finding, so an arc length is not known in advance: a "
+                             "distributed load on it covers the whole cable (leave out from_s "
+                             "and to_s)")
+                ok = False
+        return (0.0, math.inf) if ok else None
 
 
 def _mesh_node_problem(ref: str, elements: Mapping[str, int]) -> str | None:

@@ -8,6 +8,8 @@ import re
 import unicodedata
 from typing import Any
 
+import numpy as np
+
 from catdae.case.messages import _fmt_path, _found, _is_number, _short, _unknown
 from catdae.case.model import (
     AXES,
@@ -21,6 +23,7 @@ from catdae.case.schema import (
     _STEP_MODELS,
     _SupportMotion,
 )
+from catdae.case.timefunc_compose import Scaled
 
 
 class _StepsPass:
@@ -47,11 +50,17 @@ class _StepsPass:
                 ok = False
             else:
                 seen[v.node] = i
+            fixed = supports.get(v.node)
+            if "direction" in item or "value" in item:
+                funcs = self.directed_motion(v, item, where, fixed)
+                if funcs is not None and fixed is not None and ok:
+                    out.append(SupportMotion(v.node, **funcs))
+                continue
             if not any(axis in item for axis in AXES):
-                self.problem(where, "a support motion needs at least one of x, y, z")
+                self.problem(where, "a support motion needs at least one of x, y, z (or "
+                             "direction and value)")
                 ok = False
             funcs = {}
-            fixed = supports.get(v.node)
             for axis in AXES:
                 spec = getattr(v, axis)
                 if spec is None:
@@ -66,6 +75,38 @@ class _StepsPass:
             if ok and fixed is not None:
                 out.append(SupportMotion(v.node, **funcs))
         return out
+
+    def directed_motion(self, v: Any, item: dict, where: tuple, fixed) -> dict | None:
+        """``direction = [dx, dy, dz]`` with ``value = <time function>``: the displacement
+        value(t) along the unit vector of the direction, as x, y, z motions of the node."""
+        if any(axis in item for axis in AXES):
+            self.problem(where, "give either direction and value, or x, y, z, not both")
+            return None
+        if v.direction is None or v.value is None:
+            missing = "direction" if v.direction is None else "value"
+            if missing not in item:  # present but malformed: already reported
+                self.problem(where + (missing,), "missing: a motion along a direction needs "
+                             "direction = [dx, dy, dz] and value = <time function> (m)")
+            return None
+        d = np.asarray(v.direction, float)
+        norm = float(np.linalg.norm(d))
+        if not norm > 0.0:
+            self.problem(where + ("direction",), "expected a direction of non-zero length, "
+                         "found [0, 0, 0]")
+            return None
+        moved = [a for a, c in zip(AXES, d, strict=True) if c != 0.0]
+        if fixed is not None:
+            free = [a for a in moved if a not in fixed]
+            if free:
+                self.problem(where + ("direction",), f"the direction has a component along "
+                             f"axis {free[0]!r} of node {v.node!r}, which is not fixed (fixed "
+                             f"axes: {list(fixed)}); only fixed axes can be moved")
+                return None
+        tf = self.time_function(v.value, where + ("value",), motion=True)
+        if tf is None:
+            return None
+        return {a: Scaled(tf, float(c / norm)) for a, c in zip(AXES, d, strict=True)
+                if c != 0.0}
 
     def steps(self, raw: list[dict]) -> list[Step]:
         out = []
@@ -124,24 +165,64 @@ class _StepsPass:
                 extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
-                         "mass_model": v.mass_model, "inertia": v.inertia}
-            temperature = self.temperature(v.temperature_change, where)
+                         "mass_model": v.mass_model, "inertia": v.inertia,
+                         "jump_reference": self.jump_reference(v, where, out)}
+            temperature = self.step_temperature(v, where)
             if complete and temperature is not False:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
                                 add=tuple(v.add), temperature_change=temperature,
                                 **extra))
         return out
 
-    def temperature(self, raw: Any, where: tuple) -> float | FrozenMap | None | bool:
-        """A step's ``temperature_change``: K for every cable, or a table cable name -> K."""
-        where = where + ("temperature_change",)
+    def step_temperature(self, v: Any, where: tuple) -> float | FrozenMap | None | bool:
+        """A step's temperature change: its ``temperature_change``, or its ``temperature``
+        less the case's ``reference_temperature`` (a number, or per cable)."""
+        if v.temperature is None:
+            return self.temperature(v.temperature_change, where)
+        if v.temperature_change is not None:
+            self.problem(where + ("temperature",), "give either temperature or "
+                         "temperature_change, not both")
+            return False
+        if self.reference_temperature is None:
+            self.problem(where + ("temperature",), "a step's temperature needs the case's "
+                         "reference_temperature (the temperature at which the cables' lengths "
+                         "and form targets hold), e.g. reference_temperature = 15.0 at the top "
+                         "of the file; or give temperature_change instead")
+            return False
+        change = self.temperature(v.temperature, where, key="temperature")
+        ref = self.reference_temperature
+        if change is False or change is None:
+            return change
+        if isinstance(change, FrozenMap):
+            return FrozenMap({k: t - ref for k, t in change.items()})
+        return change - ref
+
+    def jump_reference(self, v: Any, where: tuple, earlier: list[Step]) -> str | None:
+        """A transient step's ``jump_reference``: the name of an earlier static step."""
+        name = v.jump_reference
+        if name is None:
+            return None
+        static = [s.name for s in earlier if s.kind == "static"]
+        if name not in static:
+            self.problem(where + ("jump_reference",), _unknown(name, "static step before this "
+                                                               "one", static))
+        return name
+
+    def temperature(self, raw: Any, where: tuple,
+                    key: str = "temperature_change") -> float | FrozenMap | None | bool:
+        """A step's ``temperature_change`` (or ``temperature``, ``key``): K for every cable,
+        or a table cable name -> K."""
+        where = where + (key,)
+        change = key == "temperature_change"
+        what = ("a temperature change in K" if change
+                else "a temperature (the units of reference_temperature)")
         if raw is None:
             return None
         if _is_number(raw):
             return float(raw)
         if not isinstance(raw, dict):
-            self.problem(where, "expected a temperature change in K (a number, for every "
-                         f"cable) or a table cable name -> K, found {_found(raw)}")
+            self.problem(where, f"expected {what} (a number, for every cable) or a table "
+                         f"cable name -> {'K' if change else 'temperature'}, found {_found(raw)}")
             return False
         ok = True
         for key, value in raw.items():
@@ -149,8 +230,8 @@ class _StepsPass:
                 self.problem(where + (key,), _unknown(key, "cable", sorted(self.cable_names)))
                 ok = False
             elif not _is_number(value):
-                self.problem(where + (key,), f"expected a temperature change in K (a finite "
-                             f"number), found {_found(value)}")
+                self.problem(where + (key,), f"expected {what} (a finite number), found "
+                             f"{_found(value)}")
                 ok = False
         return FrozenMap({k: float(v) for k, v in raw.items()}) if ok else False
 

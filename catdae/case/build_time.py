@@ -19,6 +19,7 @@ from catdae.case.schema import (
     _TableTF,
 )
 from catdae.case.timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
+from catdae.case.timefunc_compose import Product, Trapezoid
 
 
 class _TimePass:
@@ -60,6 +61,8 @@ class _TimePass:
         elif kind in ("sine", "cosine"):
             cls = Sine if kind == "sine" else Cosine
             tf = cls(float(v.amplitude), float(v.frequency), float(v.phase), float(v.offset))
+        elif kind in ("product", "trapezoid"):
+            tf = self.composed(kind, v, where, motion)
         else:
             tf = self.table(v, where, motion)
         if tf is not None and not _finite(tf):
@@ -68,6 +71,23 @@ class _TimePass:
                          "frequency or the spacing of the points")
             return None
         return tf
+
+    def composed(self, kind: str, v, where: tuple, motion: bool) -> TimeFunction | None:
+        """A ``product`` of time functions or a ``trapezoid`` (catdae.case.timefunc_compose)."""
+        if kind == "trapezoid":
+            return Trapezoid(float(v.rise), float(v.hold), float(v.fall), float(v.start),
+                             float(v.amplitude), v.smooth)
+        if len(v.factors) < 2:
+            self.problem(where + ("factors",), "expected at least 2 time functions to "
+                         f"multiply, found {len(v.factors)}")
+            return None
+        factors = []
+        for j, raw in enumerate(v.factors):
+            f = self.time_function(raw, where + ("factors", j), motion)
+            if f is None:
+                return None
+            factors.append(f)
+        return Product(tuple(factors))
 
     def table(self, v: _TableTF, where: tuple, motion: bool = False
               ) -> Table | AccelerationRecord | VelocityRecord | None:

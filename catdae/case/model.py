@@ -72,6 +72,7 @@ class Material:
     In water or air (docs/theory.md §13): ``diameter`` d, m (0: the line feels no fluid), the
     drag coefficients ``drag_normal`` and ``drag_axial`` and the added-mass coefficients
     ``added_mass_normal`` and ``added_mass_axial`` (MoorDyn's Cd, CdAx, Ca, CaAx).
+    ``rated_strength`` N (optional): results quote tensions as a percentage of it.
     """
 
     name: str
@@ -85,6 +86,7 @@ class Material:
     drag_axial: float = 0.0
     added_mass_normal: float = 0.0
     added_mass_axial: float = 0.0
+    rated_strength: float | None = None  # N: the tension quoted as 100 % (optional)
 
 
 @dataclass(frozen=True)
@@ -246,6 +248,7 @@ class Step:
     load_steps: int = 1
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
+    jump_reference: str | None = None  # transient: an earlier static step (jump_height)
 
     def __post_init__(self):
         if isinstance(self.temperature_change, Mapping):
@@ -277,6 +280,8 @@ class Case:
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
     steps: tuple[Step, ...] = ()
+    reference_temperature: float | None = None  # °C: where lengths hold (steps' temperature)
+    ground: Any = None  # catdae.case.ground.Ground: clearance results
     water: Water | None = None  # docs/case-format.md, "Water and air"
     air: Air | None = None
     path: str | None = None

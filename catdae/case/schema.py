@@ -33,6 +33,7 @@ class _Top(BaseModel):
     title: str = ""
     source: str = ""
     gravity: Any = 9.81  # a number (along -z) or [gx, gy, gz]: checked by the builder
+    reference_temperature: float | None = None  # °C (or K): where lengths hold; steps' temperature
     materials: dict[str, TomlTable] = {}
     nodes: dict[str, Any] = {}
     supports: dict[str, Any] = {}
@@ -44,6 +45,7 @@ class _Top(BaseModel):
     steps: list[TomlTable] = []
     water: Any = None  # [water] and [air]: checked by build_fluid
     air: Any = None
+    ground: TomlTable | None = None  # catdae.case.ground
 
 
 class _Material(BaseModel):
@@ -59,6 +61,7 @@ class _Material(BaseModel):
     drag_axial: NonNeg | None = None
     added_mass_normal: NonNeg | None = None
     added_mass_axial: NonNeg | None = None
+    rated_strength: Pos | None = None  # N, optional
 
 
 class _Cable(BaseModel):
@@ -110,6 +113,8 @@ class _SupportMotion(BaseModel):
     x: TomlTable | None = None
     y: TomlTable | None = None
     z: TomlTable | None = None
+    direction: Vec3 | None = None  # with value: a motion along this direction
+    value: TomlTable | None = None  # the displacement along ``direction`` (m)
 
 
 class _StaticStep(BaseModel):
@@ -118,6 +123,7 @@ class _StaticStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     load_steps: Annotated[int, Field(ge=1)] = 1
 
@@ -128,6 +134,7 @@ class _ModalStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: MassModelName = "auto"
@@ -139,6 +146,7 @@ class _TransientStep(BaseModel):
     name: Name | None = None
     remove: list[Name] = []
     temperature_change: Any = None
+    temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     duration: Time
     output_interval: Time
@@ -149,6 +157,7 @@ class _TransientStep(BaseModel):
     linear_solver: Literal["auto", "band", "sparse", "dense"] = "auto"
     mass_model: MassModelName = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
+    jump_reference: Name | None = None  # an earlier static step: jump_height results
 
 
 class _Form(BaseModel):
@@ -222,9 +231,26 @@ class _TableTF(BaseModel):
     quantity: Literal["displacement", "velocity", "acceleration"] = "displacement"
 
 
+class _ProductTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["product"]
+    factors: list[TomlTable]  # time functions, multiplied (at least 2: the builder)
+
+
+class _TrapezoidTF(BaseModel):
+    model_config = _STRICT
+    kind: Literal["trapezoid"]
+    rise: Time
+    hold: NonNeg = 0.0
+    fall: Time
+    start: float = 0.0
+    amplitude: float = 1.0
+    smooth: bool = False
+
+
 _TIME_MODELS: dict[str, type[BaseModel]] = {
     "constant": _ConstantTF, "ramp": _RampTF, "sine": _SineTF, "cosine": _SineTF,
-    "table": _TableTF,
+    "table": _TableTF, "product": _ProductTF, "trapezoid": _TrapezoidTF,
 }
 
 _VEC3 = TypeAdapter(Vec3, config=ConfigDict(strict=True, allow_inf_nan=False))

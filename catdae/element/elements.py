@@ -332,18 +332,3 @@ class Elements:
             b[slack] = frac[..., None, None] * np.eye(3)
         eye = np.eye(3)
         return np.concatenate([eye - b, b], axis=-1)
-
-
-def kernels_cached() -> bool:
-    """Whether numba's on-disk cache already holds the main compiled kernels for this source
-    and machine (False: the first call compiles them, about a minute). Uses numba's cache
-    index; if that cannot be read, answers True (nothing to announce)."""
-    try:
-        from catdae.element.residual_kernel import residual_pass
-
-        for f in (_solve_batch, _dynamics_batch, _dynamic_forces, _partial_batch, residual_pass):
-            if not f._cache._cache_file._load_index():
-                return False
-    except Exception:  # numba internals changed: do not guess
-        return True
-    return True

@@ -19,6 +19,7 @@ them as PNG files (:func:`write_all`).
 from __future__ import annotations
 
 import os
+from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -26,8 +27,9 @@ from matplotlib.figure import Figure
 
 from catdae._xr import xr
 from catdae.errors import CatdaeError
+from catdae.output.plot_envelopes import mark_peaks, reactions
 
-WHAT = ("profile", "history", "spectrum", "tension", "modes")
+WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
 
 class PlotError(CatdaeError):
@@ -38,8 +40,8 @@ def label(var: xr.DataArray, name: str | None = None) -> str:
     """'long_name [units]' from the variable's attributes (time: 's')."""
     text = name or var.attrs.get("long_name", var.name)
     units = var.attrs.get("units")
-    if units and " since " in str(units):
-        units = str(units).split(" since ")[0].replace("seconds", "s")
+    if units and " since " in str(units).lower():  # CF time: "seconds Since <epoch>"
+        units = str(units)[:str(units).lower().index(" since ")].replace("seconds", "s")
     return f"{text} [{units}]" if units else str(text)
 
 
@@ -121,9 +123,66 @@ def _node(ds: xr.Dataset, node: str | None) -> str:
         d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
             else ds.displacement
         return str(np.sqrt((d**2).sum("axis")).max("time").idxmax("node").values)
-    if node not in ds.node.values:
-        raise PlotError(f"no node {node!r} in the results (e.g. {ds.node.values[0]!r})")
-    return node
+    return select_node(ds, node)
+
+
+def _cable_nodes(ds: xr.Dataset, cable: str) -> tuple[list[str], np.ndarray]:
+    """A cable's nodes from its first end to its last and their unstrained arc lengths, m."""
+    if "element_node" in ds.coords:
+        sel = ds.element_cable.values == cable
+        nodes = ds.element_node.values[sel]  # (n, 2), in order along the cable
+        s = ds.element_s.values[sel]
+        return ([str(n) for n in nodes[:, 0]] + [str(nodes[-1, 1])],
+                np.append(s[:, 0], s[-1, 1]))
+    on = ds.node_cable.values == cable  # a group without elements (modal)
+    return [str(n) for n in ds.node.values[on]], np.asarray(ds.s.values[on], float)
+
+
+def select_node(ds: xr.Dataset, spec: str) -> str:
+    """The node label that ``spec`` names: a node of the results (``A``, ``main.7``), or a
+    point of a cable that survives remeshing: ``<cable>@<p/q>`` (unstrained arc-length fraction,
+    as ``catdae study`` names points: ``main@1/2`` is midspan; a decimal ``main@0.5`` too) or
+    ``<cable>@s=<m>`` (unstrained arc length from the cable's first end). The point must be a
+    node of this mesh; otherwise a PlotError names the nodes on either side."""
+    spec = str(spec)
+    names = [str(n) for n in ds.node.values]
+    if spec in names:
+        return spec
+    if "@" not in spec:
+        raise PlotError(f"no node {spec!r} in the results (e.g. {names[0]!r}; a point of a "
+                        "cable: <cable>@<p/q> or <cable>@s=<m>)")
+    cable, _, where = spec.partition("@")
+    cables = list(dict.fromkeys(str(c) for c in (
+        ds.element_cable.values if "element_cable" in ds.coords else ds.node_cable.values) if c))
+    if cable not in cables:
+        raise PlotError(f"{spec!r}: no cable {cable!r} in the results (cables: "
+                        f"{', '.join(cables)})")
+    nodes, s_nodes = _cable_nodes(ds, cable)
+    length = float(s_nodes[-1])
+    try:
+        if where.startswith("s="):
+            s = float(where[2:])
+            if not 0.0 <= s <= length:
+                raise PlotError(f"{spec!r}: expected 0 <= s <= {length:g} m (the length of cable "
+                                f"{cable!r}), found {s:g}")
+            at = f"s = {s:g} m"
+        else:
+            frac = Fraction(where)
+            if not 0 <= frac <= 1:
+                raise PlotError(f"{spec!r}: the fraction of the cable's length must be between "
+                                f"0 and 1, found {frac}")
+            s, at = float(frac) * length, str(frac)
+    except (ValueError, ZeroDivisionError):
+        raise PlotError(f"{spec!r}: expected <cable>@<p/q> (a fraction of the cable's length, "
+                        "e.g. main@1/2) or <cable>@s=<m> (an arc length), or a node name") \
+            from None
+    k = int(np.abs(s_nodes - s).argmin())
+    if abs(s_nodes[k] - s) <= 1e-9 * length:
+        return nodes[k]
+    j = int(np.searchsorted(s_nodes, s))
+    near = ", ".join(f"{nodes[i]} (s = {s_nodes[i]:.6g} m)" for i in (j - 1, j))
+    raise PlotError(f"{spec!r}: no mesh node at {at} of cable {cable!r} ({len(nodes) - 1} "
+                    f"elements); the nodes on either side: {near}")
 
 
 def history(data, node: str | None = None) -> Figure:
@@ -135,6 +194,7 @@ def history(data, node: str | None = None) -> Figure:
     fig, axes = _subplots(3, 1, figsize=(8, 7), sharex=True)
     for ax, a in zip(axes, ds.axis.values, strict=True):
         ax.plot(ds.time.values, d.sel(axis=a).values, gid=f"{node}|{a}")
+        mark_peaks(ax, ds, "displacement", node, str(a))  # the envelope, when stored
         ax.set_ylabel(label(ds.displacement, f"{a}"))
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel(label(ds.time, "time"))
@@ -244,6 +304,8 @@ def _figure(what: str, ds: xr.Dataset, node, times) -> Figure:
         return history(ds, node) if what == "history" else spectrum(ds, node)
     if what in ("profile", "tension"):
         return profile(ds, times) if what == "profile" else tension(ds, times)
+    if what == "reactions":
+        return reactions(ds)
     return modes(ds)
 
 
@@ -264,12 +326,20 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
         ds = tree[name].to_dataset()
         kind = ds.attrs.get("kind")
         can = {"static": ("profile", "tension"), "modal": ("modes",),
-               "transient": ("profile", "history", "spectrum", "tension")}.get(kind, ())
+               "transient": ("profile", "history", "spectrum", "tension", "reactions")
+               }.get(kind, ())
         for w in wanted:
             if w not in can:
                 continue
             fig = _figure(w, ds, node, times)
             path = folder / f"{name}-{w}.png"
             fig.savefig(path, dpi=120)
+            written.append(path)
+    if "spans" in wanted:  # one figure across the static steps (catdae.output.plot_spans)
+        from catdae.output.plot_spans import spans, static_groups
+
+        if len(static_groups(tree, steps)) >= 2:
+            path = folder / "spans.png"
+            spans(tree, steps).savefig(path, dpi=120)
             written.append(path)
     return written

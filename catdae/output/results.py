@@ -22,10 +22,14 @@ from catdae.model.mesh import AXES, Mesh
 
 CONVENTIONS = "CF-1.10"
 # CF §4.4: a time coordinate has units "<unit> since <epoch>". The case's clock has no date: its
-# seconds are stored since a nominal epoch, so that t = 4 s is 1970-01-01T00:00:04. The values
-# stay seconds (floats): read_tree opens with decode_times=False; plain xarray would decode
-# them to datetimes.
-TIME_UNITS = "seconds since 1970-01-01 00:00:00"
+# seconds are stored since a nominal epoch, so that t = 4 s is 1970-01-01T00:00:04 to a CF
+# calendar tool. Users and their plots want seconds, and plain xarray (open_dataset,
+# open_datatree with their defaults) decodes to dates only units holding a lower-case
+# "since"; UDUNITS, which CF follows (cf-units, cftime, compliance-checker), reads the keyword
+# in any case. So "Since" is written with a capital S: the file is CF time to CF tools and
+# float seconds to xarray (tests/unit/test_plain_xarray.py holds xarray to it). Files written
+# before, with "since", are read as seconds too (read_tree: decode_times=False).
+TIME_UNITS = "seconds Since 1970-01-01 00:00:00"
 TIME_ATTRS = {"units": TIME_UNITS, "calendar": "proleptic_gregorian", "standard_name": "time",
               "long_name": "time on the case's clock (t = 0 at the start of the case)",
               "axis": "T"}

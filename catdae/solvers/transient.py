@@ -69,8 +69,13 @@ def run_transient(step, model: Model, state, writer, progress) -> OutputRecord:
     """Integrate one transient step from ``state`` (positions, velocities, tensions): the
     output record (arrays and attributes). On failure or interrupt the record of what was
     computed is the exception's ``partial``; ``writer.write_increment`` gets snapshots."""
-    run = _Run(step, model, state)
-    rec = run.integrate(writer, progress)
+    # the progress reporter runs from the step's start: the set-up may compile the kernels
+    bar = reporter(progress, step.name, float(state.t), float(state.t) + float(step.duration))
+    try:
+        run = _Run(step, model, state)
+        rec = run.integrate(writer, bar)
+    finally:
+        bar.close()
     # hand the final state to the next step
     state.X = rec.X[-1].copy()
     state.V = rec.V[-1].copy()
@@ -158,12 +163,11 @@ class _Run:
         return self.outputs.upto(n_valid, self.attributes(n_valid))
 
     # ------------------------------------------------------------------ integration
-    def integrate(self, writer, progress) -> OutputRecord:
+    def integrate(self, writer, bar) -> OutputRecord:
         """Step IDA to the end, recording the output times; what was computed is kept when it
         fails (SolverError) or is interrupted (KeyboardInterrupt), both carrying ``partial``."""
         interrupt = None
         self.k_done = 0
-        bar = reporter(progress, self.step.name, self.t0, self.t_end)
         try:
             self._loop(writer, bar)
         except KeyboardInterrupt as exc:  # goes on after the partial record is attached below

@@ -46,6 +46,9 @@ the largest distance over the reference's output times between the run's displac
 (interpolated linearly in time) and the reference's, in m. For a modal step it is the largest
 relative error of the lowest natural frequencies (``response``: how many; default the step's
 ``modes``), with the signed errors per mode in ``frequency_error``.
+A modal ``response`` ``"frequency:<k>"`` takes mode k's error alone; a static study step
+(settings ``elements``, ``gauss_points``) measures the relative error of one static quantity
+of a cable, ``"<quantity>:<cable>"`` (``catdae.study.quantity``).
 
 Costs. ``wall_time`` is the time of the study step alone, from the end of the step before it to
 the end of its results (the static steps before it are not counted), in a worker that has

@@ -19,7 +19,8 @@ def _parser() -> argparse.ArgumentParser:
         "grid of settings (cartesian product), measures cost and error against a reference, "
         "writes a netCDF Dataset and PNG plots.")
     p.add_argument("case", help="case file (TOML)")
-    p.add_argument("--step", help="step to study (default: the first transient, else modal)")
+    p.add_argument("--step", help="step to study (default: the first transient, else modal, "
+                   "else static)")
     p.add_argument("--rtol", type=float, nargs="+")
     p.add_argument("--atol", type=float, nargs="+", help="m")
     p.add_argument("--elements", type=int, nargs="+", help="elements per cable")
@@ -29,7 +30,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--max-order", type=int, nargs="+")
     p.add_argument("--response", help="transient: a case node, <cable>@<p/q> or <cable>.<k> of "
                    "the case file's mesh (default: the common node moving most); modal: how "
-                   "many of the lowest frequencies are compared")
+                   "many of the lowest frequencies are compared, or frequency:<k> for mode k; "
+                   "static: <quantity>:<cable> (sag, sag_midspan, horizontal_tension, ..., "
+                   "end_tension:<cable>:<i|j>; default sag of the first cable)")
     p.add_argument("--reference", nargs="+", metavar="KEY=VALUE|FILE.nc",
                    help="reference settings (e.g. elements=64 rtol=1e-10) or a catdae results "
                    "file holding the study step")

@@ -21,6 +21,7 @@ from catdae.errors import CatdaeError
 SETTINGS = ("rtol", "atol", "elements", "gauss_points", "mass_model", "linear_solver",
             "max_order")
 MODAL_SETTINGS = ("elements", "gauss_points", "mass_model")
+STATIC_SETTINGS = ("elements", "gauss_points")  # catdae.study.quantity
 STORE_FORMAT = 1  # bump when the stored runs change meaning
 
 _COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
@@ -52,21 +53,19 @@ class StudyError(CatdaeError):
 
 
 def study_step(case: Case, step: str | None = None) -> Step:
-    """The step named ``step``; by default the first transient step, else the first modal one."""
+    """The step named ``step``; by default the first transient step, else the first modal one,
+    else the first static one (catdae.study.quantity)."""
     if step is not None:
         for s in case.steps:
             if s.name == step:
-                if s.kind == "static":
-                    raise StudyError(f"step {step!r} is static: a study needs a transient or "
-                                     "modal step")
                 return s
         names = ", ".join(repr(s.name) for s in case.steps) or "none"
         raise StudyError(f"the case has no step named {step!r} (steps: {names})")
-    for kind in ("transient", "modal"):
+    for kind in ("transient", "modal", "static"):
         for s in case.steps:
             if s.kind == kind:
                 return s
-    raise StudyError("the case has no transient or modal step to study")
+    raise StudyError("the case has no step to study")
 
 
 def settings_grid(case: Case, step: Step, given: Mapping[str, Sequence | None]) -> dict:
@@ -75,7 +74,7 @@ def settings_grid(case: Case, step: Step, given: Mapping[str, Sequence | None]) 
     Raises StudyError listing every invalid value, and any setting that does not apply to the
     step's kind.
     """
-    names = SETTINGS if step.kind == "transient" else MODAL_SETTINGS
+    names = {"transient": SETTINGS, "modal": MODAL_SETTINGS}.get(step.kind, STATIC_SETTINGS)
     problems = [f"{k}: not a setting of the {step.kind} step {step.name!r} (its settings: "
                 f"{', '.join(names)})"
                 for k, v in given.items() if v is not None and k not in names]

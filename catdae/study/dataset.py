@@ -8,6 +8,7 @@ import numpy as np
 
 from catdae._xr import xr
 from catdae.case import Step
+from catdae.study import quantity
 from catdae.study.core import _CHOICES, _COORD_META, _COUNTS, _MEMORY_NAMES
 
 
@@ -35,12 +36,13 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     data = {v: np.full(shape, np.nan) for v in ("wall_time", *_COUNTS, "peak_memory", "error")}
     status = np.full(shape, "", dtype=object)
     ref_ok = ref.attrs.get("status", "completed") == "completed"
+    single = target[1] if isinstance(target, tuple) and target[0] == "mode" else None
     if st.kind == "transient":
         if isinstance(target, list):  # the common point that moves most in the reference
             target = max(target, key=lambda p: _motion(ref, p)) if ref_ok else target[0]
         label = target
-    else:
-        n_modes = target
+    elif st.kind == "modal":
+        n_modes = single or target
         ref_f = ref.frequency.values[:n_modes] if ref_ok else np.full(n_modes, np.nan)
         ferr = np.full((*shape, n_modes), np.nan)
     for combo, key in zip(combos, keys, strict=True):
@@ -53,10 +55,13 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
             continue
         if st.kind == "transient":
             data["error"][idx] = _transient_error(rec, ref, label)
-        else:
+        elif st.kind == "modal":
             f = rec.frequency.values[:n_modes]
             ferr[idx][: f.size] = (f - ref_f[: f.size]) / ref_f[: f.size]
-            data["error"][idx] = float(np.nanmax(np.abs(ferr[idx])))
+            data["error"][idx] = float(abs(ferr[idx][single - 1]) if single
+                                       else np.nanmax(np.abs(ferr[idx])))
+    if st.kind == "static" and ref_ok:
+        quantity.static_errors(records, combos, keys, grid, ref, target, data)
     dims = tuple(names)
     coords = {}
     for n in names:
@@ -70,6 +75,10 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     if st.kind == "transient":
         err_units, err_name = "m", (f"largest distance over time between the displacement at "
                                     f"{label} and the reference's")
+    elif st.kind == "static":
+        err_units, err_name = "1", f"relative error of the {quantity.describe(target)}"
+    elif single:
+        err_units, err_name = "1", f"relative error of the natural frequency of mode {single}"
     else:
         err_units, err_name = "1", (f"largest relative error of the {n_modes} lowest natural "
                                     "frequencies")
@@ -92,8 +101,13 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
         out["frequency_error"] = xr.Variable(
             (*dims, "mode"), ferr, {"units": "1", "long_name": "relative error of the natural "
                                     "frequency (f - f_ref) / f_ref"})
-        out.attrs["response"] = f"{n_modes} lowest natural frequencies"
-        out.attrs["error_definition"] = "max over the modes of |f - f_ref| / f_ref"
+        out.attrs["response"] = (f"natural frequency of mode {single}" if single
+                                 else f"{n_modes} lowest natural frequencies")
+        out.attrs["error_definition"] = (f"|f - f_ref| / f_ref of mode {single}" if single
+                                         else "max over the modes of |f - f_ref| / f_ref")
+    elif st.kind == "static":
+        out.attrs["response"] = quantity.describe(target)
+        out.attrs["error_definition"] = "|q - q_ref| / |q_ref|"
     else:
         out.attrs["response"] = label
         out.attrs["error_definition"] = (f"max over the reference's output times of |u_run - "

@@ -32,6 +32,7 @@ from catdae.study.core import (
     study_step,
 )
 from catdae.study.dataset import _assemble
+from catdae.study.quantity import frequency_target, static_target, static_values
 from catdae.study.store import _clean, _store_read, _store_write
 from catdae.study.worker import _MemoryProbe
 
@@ -78,8 +79,10 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         given_points = set(ref_data.point.values) if given_ref else None
         target = _transient_target(case, run_cases + ([ref_case] if ref_case else []), response,
                                    grid, given_points)
+    elif st.kind == "static":
+        target = static_target(case, response)
     else:
-        target = _modal_target(st, response)
+        target = frequency_target(response, st.modes) or _modal_target(st, response)
     ref_key = None if given_ref else run_key(ref_case, st.name, memory)
 
     store_dir = Path(store) if store is not None else None
@@ -164,6 +167,8 @@ def _given_reference(reference, st: Step, case: Case) -> xr.Dataset:
             raise StudyError(f"reference: the results have no group {st.name!r}")
         ds = ds[st.name].to_dataset()
     attrs = {"status": str(ds.attrs.get("status", "completed")), "wall_time": math.nan}
+    if st.kind == "static":
+        return static_values(ds, attrs)
     if st.kind == "modal":
         if "frequency" not in ds:
             raise StudyError("reference: a modal study needs a 'frequency' variable")

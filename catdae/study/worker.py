@@ -59,6 +59,10 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
         return xr.Dataset(attrs=attrs)
     if step.kind == "modal":
         return xr.Dataset({"frequency": ("mode", group.frequency.values)}, attrs=attrs)
+    if step.kind == "static":
+        from catdae.study.quantity import static_values
+
+        return static_values(group, attrs)
     labels = point_labels(case_run, [str(n) for n in group.node.values])
     keep = [i for i, lab in enumerate(labels) if lab is not None]
     return xr.Dataset(

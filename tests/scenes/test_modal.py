@@ -34,7 +34,15 @@ from catdae.solvers.static import solve_static
 
 from reference import irvine_catenary, irvine_caughey_frequencies
 from repo_paths import ROOT  # noqa: E402
-from scene_toml import cable_scene, modal_step, static_step
+from scene_toml import (
+    cable,
+    cable_scene,
+    distributed_load,
+    modal_step,
+    point_mass,
+    scene,
+    static_step,
+)
 
 EXAMPLE1 = ROOT / "cases" / "example1_free_vibration.toml"
 G = 9.81
@@ -220,111 +228,25 @@ def test_convergence_order(lambda2, sag_ratio, meshes):
 # ----------------------------------------------------------------------------------------------
 MASS_SCENES = {
     # level, sagging, point masses at a node and inside elements
-    "sagging": """
-[materials.s]
-EA = 4.696e8
-mass = 20.3
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [44.335, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "main"
-ends = ["A", "B"]
-material = "s"
-length = 46.0
-elements = 7
-[[point_masses]]
-name = "at_node"
-node = "main.3"
-mass = 55.0
-[[point_masses]]
-name = "inside"
-cable = "main"
-s = 3.1
-mass = 100.0
-[[point_masses]]
-name = "inside2"
-cable = "main"
-s = 3.9
-mass = 7.0
-""",
+    "sagging": cable_scene(
+        material="s", cable="main", B=(44.335, 0.0, 0.0), L0=46.0, EA=4.696e8, mass=20.3,
+        elements=7,
+        extra=(point_mass("at_node", 55.0, node="main.3")
+               + point_mass("inside", 100.0, cable="main", s=3.1)
+               + point_mass("inside2", 7.0, cable="main", s=3.9))),
     # inclined in 3-D, pushed out of its vertical plane by a lateral wind
-    "inclined_3d": """
-[materials.r]
-EA = 2.0e7
-mass = 3.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [30.0, 20.0, 15.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "r"
-length = 42.0
-elements = 9
-gauss_points = 4
-[[distributed_loads]]
-cable = "c"
-load = [10.0, -20.0, 0.0]
-[[point_masses]]
-name = "pm"
-cable = "c"
-s = 30.7
-mass = 40.0
-""",
+    "inclined_3d": cable_scene(
+        material="r", B=(30.0, 20.0, 15.0), L0=42.0, EA=2.0e7, mass=3.0, elements=9,
+        gauss_points=4,
+        extra=(distributed_load("c", [10.0, -20.0, 0.0])
+               + point_mass("pm", 40.0, cable="c", s=30.7))),
     # taut: unstrained length shorter than the chord
-    "taut": """
-[materials.r]
-EA = 1.0e6
-mass = 1.5
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 1.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "r"
-length = 9.95
-elements = 5
-[[point_masses]]
-name = "pm"
-cable = "c"
-s = 4.2
-mass = 3.0
-""",
+    "taut": cable_scene(material="r", B=(10.0, 0.0, 1.0), L0=9.95, EA=1.0e6, mass=1.5,
+                        elements=5, extra=point_mass("pm", 3.0, cable="c", s=4.2)),
     # weightless with a point mass: the mesh sags under it; slack elements are made below
-    "weightless": """
-[materials.r]
-EA = 1.0e5
-mass = 1.0
-weight = 0.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [8.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "r"
-length = 10.0
-elements = 4
-[[point_masses]]
-name = "pm"
-cable = "c"
-s = 3.3
-mass = 20.0
-""",
+    "weightless": cable_scene(material="r", B=(8.0, 0.0, 0.0), L0=10.0, EA=1.0e5, mass=1.0,
+                              weight=0.0, elements=4,
+                              extra=point_mass("pm", 20.0, cable="c", s=3.3)),
     "three_cables": (ROOT / "cases" / "three_cables_shared_node.toml").read_text(),
 }
 
@@ -407,47 +329,18 @@ def test_mass_matrix_identities(name, mass_model):
 # ----------------------------------------------------------------------------------------------
 # invariance: numbering, orientation, mirror
 # ----------------------------------------------------------------------------------------------
-INVARIANCE_BASE = """
-[materials.r]
-EA = 2.0e7
-mass = 3.0
-[nodes]
-{nodes}
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = {ends}
-material = "r"
-length = 41.5
-elements = 10
-[[point_masses]]
-name = "pm"
-cable = "c"
-s = {s}
-mass = 25.0
-[[distributed_loads]]
-cable = "c"
-load = [0.0, 15.0, 0.0]
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 10
-"""
-
-
 def _invariance_case(order="AB", reverse=False, mirror=False):
     xs = {"A": 0.0, "B": 40.0}
     zs = {"A": 0.0, "B": 8.0}
     sign = -1.0 if mirror else 1.0
-    nodes = "\n".join(f"{n} = [{sign * xs[n]!r}, 0.0, {zs[n]!r}]" for n in order)
-    ends = '["B", "A"]' if reverse else '["A", "B"]'
+    ends = ("B", "A") if reverse else ("A", "B")
     s = 41.5 - 13.3 if reverse else 13.3  # the same material point
-    return INVARIANCE_BASE.format(nodes=nodes, ends=ends, s=s)
+    return scene(materials={"r": {"EA": 2.0e7, "mass": 3.0}},
+                 nodes={n: (sign * xs[n], 0.0, zs[n]) for n in order},
+                 cables=[cable("c", ends, "r", 41.5, 10)],
+                 extra=(point_mass("pm", 25.0, cable="c", s=s)
+                        + distributed_load("c", [0.0, 15.0, 0.0])),
+                 steps=static_step() + modal_step(10))
 
 
 def test_frequencies_independent_of_numbering_and_mirror():

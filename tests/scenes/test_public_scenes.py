@@ -26,7 +26,18 @@ from reference import (
     irvine_catenary_inclined_3d,
     taut_string_frequencies,
 )
-from scene_toml import cable_scene, static_step, transient_step
+from scene_toml import (
+    cable,
+    cable_scene,
+    load,
+    modal_step,
+    point_mass,
+    scene,
+    static_step,
+    step,
+    support_motion,
+    transient_step,
+)
 
 G = 9.81
 
@@ -144,41 +155,15 @@ def test_uniform_side_load_converges_to_the_catenary_under_the_resultant_load():
 
 
 def test_symmetric_four_cable_net_is_symmetric_and_each_cable_is_a_catenary():
-    cables = ""
-    for name, ends in (("cn", '"C", "N"'), ("ce", '"E", "C"'), ("cs", '"C", "S"'),
-                       ("cw", '"W", "C"')):
-        cables += (f'[[cables]]\nname = "{name}"\nends = [{ends}]\nmaterial = "r"\n'
-                   "length = 21.5\nelements = 4\n")
-    case = f"""
-title = "net"
-[materials.r]
-EA = 2.0e7
-mass = 3.0
-[nodes]
-N = [20.0, 0.0, 10.0]
-E = [0.0, 20.0, 10.0]
-S = [-20.0, 0.0, 10.0]
-W = [0.0, -20.0, 10.0]
-C = [0.0, 0.0, 4.0]
-[supports]
-N = "pinned"
-E = "pinned"
-S = "pinned"
-W = "pinned"
-{cables}
-[[point_masses]]
-name = "payload"
-node = "C"
-mass = 300.0
-[[loads]]
-name = "down"
-node = "C"
-force = [0.0, 0.0, -1000.0]
-[[steps]]
-kind = "static"
-name = "st"
-load_steps = 2
-"""
+    cables = [cable(name, ends, "r", 21.5, 4)
+              for name, ends in (("cn", "CN"), ("ce", "EC"), ("cs", "CS"), ("cw", "WC"))]
+    case = scene(head={"title": "net"}, materials={"r": {"EA": 2.0e7, "mass": 3.0}},
+                 nodes={"N": (20.0, 0.0, 10.0), "E": (0.0, 20.0, 10.0), "S": (-20.0, 0.0, 10.0),
+                        "W": (0.0, -20.0, 10.0), "C": (0.0, 0.0, 4.0)},
+                 supports=("N", "E", "S", "W"), cables=cables,
+                 extra=(point_mass("payload", 300.0, node="C")
+                        + load("down", [0.0, 0.0, -1000.0], node="C")),
+                 steps=step("static", "st", load_steps=2))
     ds = catdae.run(case)["st"].ds
     total = 4 * 21.5 * 3.0 * G + 300.0 * G + 1000.0
     np.testing.assert_allclose(np.nansum(ds.reaction.values, axis=0), [0, 0, total], atol=1e-6)
@@ -249,60 +234,24 @@ def test_release_of_a_load_conserves_energy_and_consecutive_steps_join():
     np.testing.assert_allclose(a.velocity.isel(time=-1).values, b.velocity.isel(time=0).values)
 
 
-SUPPORT_MOTION_NET = """
-title = "support motions on three supports"
-[materials.m]
-EA = 1.0e6
-mass = 2.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 1.0]
-C = [5.0, 8.0, 0.5]
-M = [5.0, 0.0, -0.3]
-[supports]
-A = "pinned"
-B = "pinned"
-C = "pinned"
-[[cables]]
-name = "am"
-ends = ["A", "M"]
-material = "m"
-length = 5.1
-elements = 2
-[[cables]]
-name = "mb"
-ends = ["M", "B"]
-material = "m"
-length = 5.1
-elements = 2
-[[cables]]
-name = "cm"
-ends = ["C", "M"]
-material = "m"
-length = 8.2
-elements = 2
-[[support_motions]]
-node = "A"
-x = { kind = "cosine", amplitude = -0.02, frequency = 2.0, offset = 0.02 }
-z = { kind = "cosine", amplitude = -0.03, frequency = 1.0, offset = 0.03 }
-[[support_motions]]
-node = "B"
-z = { kind = "ramp", duration = 0.3, amplitude = 0.04, smooth = true, start = 0.1 }
-[[support_motions]]
-node = "C"
-x = { kind = "table", t = [0.0, 0.3, 0.6], value = [0.0, -0.05, -0.02] }
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "transient"
-name = "tr"
-duration = 0.3
-output_interval = 0.002
-rtol = 1e-8
-atol = 1e-10
-mass_model = "MASS_MODEL"
-"""
+SUPPORT_MOTION_NET = scene(
+    head={"title": "support motions on three supports"},
+    materials={"m": {"EA": 1.0e6, "mass": 2.0}},
+    nodes={"A": (0.0, 0.0, 0.0), "B": (10.0, 0.0, 1.0), "C": (5.0, 8.0, 0.5),
+           "M": (5.0, 0.0, -0.3)},
+    supports=("A", "B", "C"),
+    cables=[cable("am", "AM", "m", 5.1, 2), cable("mb", "MB", "m", 5.1, 2),
+            cable("cm", "CM", "m", 8.2, 2)],
+    extra=(support_motion("A", x={"kind": "cosine", "amplitude": -0.02, "frequency": 2.0,
+                                  "offset": 0.02},
+                          z={"kind": "cosine", "amplitude": -0.03, "frequency": 1.0,
+                             "offset": 0.03})
+           + support_motion("B", z={"kind": "ramp", "duration": 0.3, "amplitude": 0.04,
+                                    "smooth": True, "start": 0.1})
+           + support_motion("C", x={"kind": "table", "t": [0.0, 0.3, 0.6],
+                                    "value": [0.0, -0.05, -0.02]})),
+    steps=static_step() + transient_step("tr", 0.3, 0.002, rtol=1e-8, atol=1e-10,
+                                         extra='mass_model = "MASS_MODEL"'))
 
 
 @pytest.mark.parametrize("mass_model", ["consistent", "lumped"])
@@ -377,20 +326,9 @@ def test_mass_proportional_rayleigh_damping_decays_at_alpha_over_two():
 # --------------------------------------------------------------------------------------------------
 def test_cli_run_writes_groups_with_units_and_rejects_bad_input(tmp_path):
     case = tmp_path / "span.toml"
-    case.write_text(single_span((10.0, 0.0, 0.0), 10.2, 1.0e6, 2.0, 4, steps="""
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "modal"
-name = "md"
-modes = 3
-[[steps]]
-kind = "transient"
-name = "tr"
-duration = 0.02
-output_interval = 0.01
-"""))
+    case.write_text(single_span((10.0, 0.0, 0.0), 10.2, 1.0e6, 2.0, 4, steps=(
+        static_step() + modal_step(3, "md")
+        + step("transient", "tr", duration=0.02, output_interval=0.01))))
     out = tmp_path / "span.nc"
     r = subprocess.run([sys.executable, "-m", "catdae", "run", str(case), "-o", str(out)],
                        capture_output=True, text=True, timeout=120)

@@ -16,31 +16,17 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
 
 import catdae
 from catdae.errors import CaseError
 
+from reference import level_catenary_midspan
 from scene_toml import cable_scene, static_step
 
 # code_aster V6.02.114 (SSNL114): 2 l0 = 2 L = 325 m, A = 2.2783e-4 m², E = 5.7e10 Pa,
 # α = 2.3e-5 /K, ρ = 2844.23 kg/m³, g = 9.81; heated from 0 to 39.26 °C
 SSNL = dict(L=325.0, A=2.2783e-4, E=5.7e10, alpha=2.3e-5, rho=2844.23, g=9.81, dT=39.26)
 SSNL114_MIDSPAN = -8.195  # m, published, to 1e-3 (weight per heated length)
-
-
-def level_catenary_midspan(L0, EA, w, eps_t, span=None):
-    """(midspan height below the supports (< 0), H) of an elastic catenary of unstrained length
-    L0 between level supports ``span`` apart (default L0) with stretch 1 + eps_t + T/EA
-    (Irvine 1981, §2.2 with a thermal strain): span = H L0/EA + (1 + eps_t) (2H/w)
-    asinh(w L0/(2H)), z_mid = (1 + eps_t) (H - sqrt(H² + (w L0/2)²))/w - w L0²/(8 EA)."""
-    span = L0 if span is None else span
-
-    def gap(H):
-        return H * L0 / EA + (1.0 + eps_t) * 2.0 * H / w * math.asinh(w * L0 / (2.0 * H)) - span
-    H = brentq(gap, 1e-6 * w * L0, 1e3 * w * L0, xtol=1e-13, rtol=1e-15)
-    return ((1.0 + eps_t) * (H - math.hypot(H, 0.5 * w * L0)) / w
-            - w * L0**2 / (8.0 * EA)), H
 
 
 def ssnl114_text(elements=10):

@@ -20,48 +20,20 @@ from catdae.case.timefunc import Cosine, Ramp, Sine, Table
 from catdae.errors import CaseError
 
 from repo_paths import CASES  # noqa: E402
+from scene_toml import cable_scene, load, point_mass, step, support_motion
 
 EXAMPLE = CASES / "format_example.toml"
 
 # A small valid case that the bad-input tests break one key at a time.
-BASE_TOML = """
-title = "base"
-[materials.strand]
-EA = 1.0e7
-mass = 2.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "main"
-ends = ["A", "B"]
-material = "strand"
-length = 10.5
-elements = 4
-[[point_masses]]
-name = "hung"
-cable = "main"
-s = 5.0
-mass = 10.0
-[[loads]]
-name = "gust"
-node = "main.2"
-force = [0.0, 100.0, 0.0]
-time = { kind = "ramp", duration = 0.5 }
-[[support_motions]]
-node = "A"
-y = { kind = "sine", amplitude = 0.1, frequency = 0.5 }
-[[steps]]
-kind = "static"
-[[steps]]
-kind = "transient"
-remove = ["hung"]
-duration = 2.0
-output_interval = 0.1
-"""
+BASE_TOML = cable_scene(
+    title="base", material="strand", cable="main", B=(10.0, 0.0, 0.0), L0=10.5, EA=1.0e7,
+    mass=2.0, elements=4,
+    extra=(point_mass("hung", 10.0, cable="main", s=5.0)
+           + load("gust", [0.0, 100.0, 0.0], node="main.2",
+                  time={"kind": "ramp", "duration": 0.5})
+           + support_motion("A", y={"kind": "sine", "amplitude": 0.1, "frequency": 0.5})),
+    steps=step("static") + step("transient", remove=["hung"], duration=2.0,
+                                output_interval=0.1))
 BASE = tomllib.loads(BASE_TOML)
 
 

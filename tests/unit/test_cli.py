@@ -18,26 +18,13 @@ from catdae import ConvergenceError
 from catdae.cli import default_case_path, main
 
 from repo_paths import CASES  # noqa: E402
+from scene_toml import cable_scene
 
 THREE = CASES / "three_cables_shared_node.toml"
 
-BAD = """
-title = "bad"
-[materials.m]
-EA = -1.0
-mas = 3.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 11.0
-"""
+# bad on purpose: a negative EA, and "mas" for "mass"
+BAD = cable_scene(title="bad", B=(10.0, 0.0, 0.0), L0=11.0, EA=-1.0, mass=3.0).replace(
+    "mass = 3.0", "mas = 3.0")
 
 
 def test_run_writes_the_results(tmp_path, capsys):

@@ -14,12 +14,7 @@ from __future__ import annotations
 
 import errno
 import os
-import re
 import signal
-import subprocess
-import sys
-import threading
-import time
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -32,67 +27,17 @@ import catdae.analysis
 import catdae.output.results
 from catdae.cli import main
 
+from processes import catdae_process, signal_when, transient_runs
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, static_step, transient_step
+from scene_toml import long_transient
 
 THREE = CASES / "three_cables_shared_node.toml"
-PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
 
 
 def long_case(path: Path, duration: float = 1000.0) -> Path:
-    """A weightless taut cable, pushed sideways, then released for ``duration`` seconds
-    (about 200 s of wall time per 1000 s simulated: always interrupted long before its end)."""
-    path.write_text(cable_scene(
-        B=(10.0, 0.0, 0.0), L0=10.0 / 1.1, EA=1e4, mass=2.0, weight=0.0, elements=2,
-        extra=PUSH, steps=static_step("static") + transient_step(
-            "dyn", duration, 0.01, rtol=1e-6, atol=1e-9, remove=["push"])))
+    """``scene_toml.long_transient`` written to ``path``."""
+    path.write_text(long_transient(duration))
     return path
-
-
-def catdae_process(args, cwd, *, snapshot_seconds=None):
-    """``python -m catdae ARGS``; with ``snapshot_seconds`` the same command line with the
-    transient snapshot interval lowered (catdae.solvers.transient.INCREMENT_SECONDS, 20 s)."""
-    if snapshot_seconds is None:
-        cmd = [sys.executable, "-m", "catdae", *args]
-    else:
-        code = ("import sys, catdae.solvers.transient as t, catdae.cli as c; "
-                f"t.INCREMENT_SECONDS = {snapshot_seconds!r}; sys.exit(c.main(sys.argv[1:]))")
-        cmd = [sys.executable, "-c", code, *args]
-    return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd,
-                            env=dict(os.environ, PYTHONUNBUFFERED="1"))
-
-
-def signal_when(proc, sig, ready, timeout=180.0) -> tuple[int, str]:
-    """Send ``sig`` once ``ready(stderr so far)`` holds; return (exit code, stderr)."""
-    chunks: list[bytes] = []
-
-    def read_err():
-        while b := proc.stderr.read1(4096):
-            chunks.append(b)
-
-    reader = threading.Thread(target=read_err, daemon=True)
-    reader.start()
-    try:
-        deadline = time.monotonic() + timeout
-        while not ready(b"".join(chunks).decode(errors="replace")):
-            assert proc.poll() is None, b"".join(chunks).decode(errors="replace")
-            assert time.monotonic() < deadline, b"".join(chunks).decode(errors="replace")
-            time.sleep(0.05)
-        proc.send_signal(sig)
-        code = proc.wait(120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    reader.join(10)
-    proc.stderr.close()
-    return code, b"".join(chunks).decode(errors="replace")
-
-
-def transient_runs(err: str) -> bool:
-    """The progress bar of the transient step shows that it has passed t = 1 s."""
-    shown = re.findall(r"dyn:.*?t=([0-9.]+)/", err)
-    return bool(shown) and float(shown[-1]) > 1.0
 
 
 def test_sigterm_in_a_transient_step_keeps_and_marks_the_partial_results(tmp_path):

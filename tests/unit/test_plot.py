@@ -65,7 +65,7 @@ def test_history_is_the_displacement_of_the_node(ex1):
     ds = tree["release"].to_dataset()
     fig = plot.history(ds, "main.4")
     for ax, a in zip(fig.axes, "xyz", strict=True):
-        (ln,) = ax.get_lines()
+        (ln,) = _lines(ax, f"main.4|{a}")[:1]  # then the envelope's peak markers
         np.testing.assert_array_equal(ln.get_xdata(), ds.time.values)
         np.testing.assert_array_equal(ln.get_ydata(), ds.displacement.sel(node="main.4",
                                                                           axis=a).values)

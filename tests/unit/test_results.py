@@ -17,54 +17,19 @@ import catdae
 import catdae.analysis
 from catdae import ConvergenceError
 
-CASE = """
-title = "Round trip"
-source = "tests/unit/test_results.py"
+from scene_toml import cable as cable_toml
+from scene_toml import load, modal_step, scene, static_step, step
 
-[materials.wire]
-EA = 3.4e7
-mass = 5.0
-
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 1.0]
-
-[supports]
-A = "pinned"
-B = "pinned"
-
-[[cables]]
-name = "cable"
-ends = ["A", "B"]
-material = "wire"
-length = 11.0
-elements = 4
-
-[[loads]]
-name = "tap"
-node = "cable.2"
-force = [0.0, 20.0, -30.0]
-time = { kind = "ramp", duration = 0.02 }
-
-[[steps]]
-kind = "static"
-name = "first"
-
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 4
-
-[[steps]]
-kind = "transient"
-name = "tapped"
-duration = 0.04
-output_interval = 0.01
-
-[[steps]]
-kind = "static"
-name = "second"
-"""
+CASE = scene(
+    head={"title": "Round trip", "source": "tests/unit/test_results.py"},
+    materials={"wire": {"EA": 3.4e7, "mass": 5.0}},
+    nodes={"A": (0.0, 0.0, 0.0), "B": (10.0, 0.0, 1.0)},
+    cables=[cable_toml("cable", material="wire", length=11.0, elements=4)],
+    extra=load("tap", [0.0, 20.0, -30.0], node="cable.2",
+               time={"kind": "ramp", "duration": 0.02}),
+    steps=(static_step("first") + modal_step(4)
+           + step("transient", "tapped", duration=0.04, output_interval=0.01)
+           + static_step("second")))
 
 ROOT_ATTRS = ("title", "source", "case_toml", "catdae_version", "created", "status")
 
@@ -149,8 +114,9 @@ def test_group_kinds_and_dimensions(written):
     assert md.shape.dims == ("mode", "node", "axis")
     tr = back["tapped"].to_dataset()
     assert tr.position.dims == ("time", "node", "axis")
-    # CF time: seconds since a nominal epoch, kept as seconds (floats) by read_results
-    assert tr.time.attrs["units"] == "seconds since 1970-01-01 00:00:00"
+    # CF time: seconds since a nominal epoch (UDUNITS' keyword in any case; xarray decodes
+    # only a lower-case "since"), kept as seconds (floats) by read_results and plain xarray
+    assert tr.time.attrs["units"].lower() == "seconds since 1970-01-01 00:00:00"
     assert tr.time.attrs["standard_name"] == "time" and tr.time.dtype == np.float64
     np.testing.assert_allclose(tr.time.values, [0.0, 0.01, 0.02, 0.03, 0.04], atol=1e-12)
     assert tr.attrs["status"] == "completed"

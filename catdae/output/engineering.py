@@ -1,0 +1,174 @@
+"""Engineering results of a step: span quantities, tension against the rated strength, and the
+envelopes of a transient over its output times (docs/case-format.md, "What an engineer reads").
+
+Static groups get, per cable, the span quantities of :func:`catdae.model.span.span_quantities`
+and ``tension_percent_rated``. Transient groups get per node the extremes of ``reaction`` and
+``displacement`` with their times, per cable ``tension_percent_rated`` (largest over the
+outputs) and, when the step names a ``jump_reference`` static step, the largest rise of each
+cable above its position there (``jump_height``, an ice-shedding jump). Envelopes are taken
+over the stored output times: a peak between two outputs is missed by at most what the motion
+does in one output interval.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catdae._xr import xr
+
+_SPAN = {  # name: (units, long_name)
+    "horizontal_tension_along_chord": (
+        "N", "horizontal tension along the chord (the first end's tension along the chord's "
+        "horizontal direction; without the part across the chord)"),
+    "sag_midspan": ("m", "vertical distance from the chord to the cable at midspan (halfway "
+                    "between the ends in plan)"),
+    "swing_angle": ("degree", "angle from the vertical of the line from the chord to the "
+                    "cable at midspan (swing under loads across the span)"),
+    "sag_lowest_point": ("m", "depth of the cable's lowest point below its lower end (0: the "
+                         "lowest point is an end)"),
+    "lowest_point_s": ("m", "unstrained arc length of the cable's lowest point"),
+    "lowest_point_elevation": ("m", "height of the cable's lowest point"),
+    "tension_max_along_cable": ("N", "largest tension along the cable"),
+}
+
+
+_CLEARANCE = "least height of the cable above the case's [ground] (negative: below it)"
+
+
+def _cable_var(values, units: str, long_name: str) -> xr.Variable:
+    return xr.Variable("cable", np.asarray(values, float),
+                       {"units": units, "long_name": long_name})
+
+
+def rated_strengths(case, cable_names) -> np.ndarray:
+    """The material's ``rated_strength`` of each cable, N (NaN where not given)."""
+    out = []
+    for name in cable_names:
+        r = case.material_of(str(name)).rated_strength
+        out.append(np.nan if r is None else float(r))
+    return np.array(out)
+
+
+def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
+               rated: np.ndarray) -> xr.Dataset:
+    """The static group with the span quantities (per ``cable``) and the largest tension as a
+    percentage of the rated strength."""
+    data = {}
+    for key, (units, long_name) in _SPAN.items():
+        source = "tension_max" if key == "tension_max_along_cable" else key
+        data[key] = _cable_var(quantities[source], units, long_name)
+    if np.isfinite(rated).any():
+        data["tension_percent_rated"] = _cable_var(
+            100.0 * quantities["tension_max"] / rated, "percent",
+            "largest tension along the cable as a percentage of the material's rated_strength")
+    if "clearance" in quantities:
+        data["clearance"] = _cable_var(quantities["clearance"], "m", _CLEARANCE)
+        data["clearance_s"] = _cable_var(quantities["clearance_s"], "m",
+                                         "unstrained arc length where the clearance is least")
+    return ds.assign(data)
+
+
+def _extreme(var: xr.DataArray, how: str, what: str) -> dict[str, xr.Variable]:
+    """``<name>_<how>`` and ``<name>_<how>_time`` over time (NaN where the variable is NaN
+    throughout, e.g. reactions at free nodes)."""
+    v = var.values  # (time, ...)
+    t = var["time"].values
+    finite = np.isfinite(v).any(axis=0)
+    filled = np.where(np.isfinite(v), v, -np.inf if how == "max" else np.inf)
+    k = filled.argmax(axis=0) if how == "max" else filled.argmin(axis=0)
+    value = np.take_along_axis(v, k[None], axis=0)[0]
+    when = np.where(finite, t[k], np.nan)
+    value = np.where(finite, value, np.nan)
+    dims = var.dims[1:]
+    word = "largest" if how == "max" else "smallest"
+    name = str(var.name)
+    return {
+        f"{name}_{how}": xr.Variable(dims, value, {
+            "units": var.attrs.get("units", ""),
+            "long_name": f"{word} {what} over the output times"}),
+        f"{name}_{how}_time": xr.Variable(dims, when, {
+            "units": "s", "long_name": f"time of the {word} {what}"}),
+    }
+
+
+def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
+                  up: np.ndarray | None = None) -> xr.Dataset:
+    """The transient group with its envelopes over the output times: ``reaction_max``,
+    ``reaction_min`` (node, axis) and their ``_time``, the same for ``displacement``; per
+    cable ``tension_percent_rated`` when a material has a rated strength; and with
+    ``reference`` (the named static step's group) ``jump_height``, ``jump_time`` and
+    ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z)."""
+    if ds.sizes.get("time", 0) == 0:
+        return ds
+    data = {}
+    for how in ("max", "min"):
+        data.update(_extreme(ds.reaction, how, "force the support exerts on the cable"))
+        data.update(_extreme(ds.displacement, how, "displacement"))
+    cables = list(dict.fromkeys(str(c) for c in ds.element_cable.values))
+    rated = rated_strengths(case, cables)
+    if np.isfinite(rated).any():
+        t_max = [float(ds.tension.values[:, ds.element_cable.values == c].max()) for c in cables]
+        data["tension_percent_rated"] = _cable_var(
+            100.0 * np.array(t_max) / rated, "percent",
+            "largest tension along the cable over the output times as a percentage of the "
+            "material's rated_strength")
+    out = ds.assign_coords(cable=xr.Variable("cable", np.array(cables, dtype=object),
+                                             {"long_name": "cable name"})).assign(data)
+    if reference is not None:
+        out = out.assign(jump(ds, reference, cables, up))
+    if getattr(case, "ground", None) is not None:
+        out = out.assign(clearance_over_time(ds, case.ground, cables, up))
+    return out
+
+
+def clearance_over_time(ds: xr.Dataset, ground, cables: list[str],
+                        up: np.ndarray | None = None) -> dict[str, xr.Variable]:
+    """Per cable the least height of its nodes above the ground over the output times, when
+    and where (at the nodes: between nodes the exact curve is not stored in a transient)."""
+    up = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, float)
+    x = ds.position.values  # (time, node, 3) m
+    gap = x @ up - ground.height(x[..., 0])  # (time, node) m
+    least, when, where = [], [], []
+    for c in cables:
+        sel = ds.element_cable.values == c
+        nodes = np.unique(ds.element_node.values[sel])
+        k = np.flatnonzero(np.isin(ds.node.values.astype(str), nodes.astype(str)))
+        g = gap[:, k]
+        k_t, k_n = np.unravel_index(int(np.argmin(g)), g.shape)
+        least.append(float(g[k_t, k_n]))
+        when.append(float(ds.time.values[k_t]))
+        node = str(ds.node.values[k[k_n]])
+        at = (ds.element_node.values == node) & sel[:, None]
+        where.append(float(ds.element_s.values[at][0]))
+    return {
+        "clearance": _cable_var(least, "m", _CLEARANCE + ", at the nodes, over the output "
+                                "times"),
+        "clearance_time": _cable_var(when, "s", "time of the least clearance"),
+        "clearance_s": _cable_var(where, "m", "unstrained arc length of the node of least "
+                                  "clearance"),
+    }
+
+
+def jump(ds: xr.Dataset, reference: xr.Dataset, cables: list[str],
+         up: np.ndarray | None = None) -> dict[str, xr.Variable]:
+    """Per cable the largest rise of a node of the cable above its position in ``reference``
+    over the output times (m, along ``up``), when and where (the node's arc length)."""
+    up = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, float)
+    rise = ((ds.position - reference.position.sel(node=ds.node)) * xr.DataArray(
+        up, dims="axis", coords={"axis": ds.axis})).sum("axis")  # (time, node) m
+    height, when, where = [], [], []
+    for c in cables:
+        nodes = np.unique(ds.element_node.values[ds.element_cable.values == c])
+        r = rise.sel(node=nodes)
+        k_t, k_n = np.unravel_index(int(np.nanargmax(r.values)), r.shape)
+        height.append(float(r.values[k_t, k_n]))
+        when.append(float(ds.time.values[k_t]))
+        node = str(r.node.values[k_n])
+        sel = (ds.element_node.values == node) & (ds.element_cable.values == c)[:, None]
+        where.append(float(ds.element_s.values[sel][0]))
+    return {
+        "jump_height": _cable_var(height, "m", "largest rise of the cable above its position "
+                                  "in the jump_reference step, over the output times"),
+        "jump_time": _cable_var(when, "s", "time of the largest rise"),
+        "jump_s": _cable_var(where, "m", "unstrained arc length of the node that rises most"),
+    }

@@ -1,0 +1,62 @@
+"""The figure of a span across static steps: sag and tension against the conductor
+temperature (a sag-temperature table) or against the steps, for every cable.
+
+``catdae plot RESULT.nc -o FOLDER --what spans`` writes it as ``spans.png`` when the results
+hold two or more static steps with span quantities (catdae.output.engineering).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from catdae._xr import xr
+
+
+def static_groups(tree: xr.DataTree, steps=None) -> list[tuple[str, xr.Dataset]]:
+    """(name, dataset) of the static steps with span quantities, in step order."""
+    names = list(tree.children) if not steps else list(steps)
+    out = []
+    for name in names:
+        ds = tree[name].to_dataset()
+        if ds.attrs.get("kind") == "static" and "sag_midspan" in ds:
+            out.append((name, ds))
+    return out
+
+
+def spans(tree: xr.DataTree, steps=None) -> Figure:
+    """Sag at midspan and at the lowest point (above), the largest tension as a percentage of
+    the rated strength, or else the horizontal tension along the chord (below), per cable,
+    against the steps' ``temperature`` when every step has one, else against the steps."""
+    groups = static_groups(tree, steps)
+    temps = [ds.attrs.get("temperature") for _, ds in groups]
+    by_temperature = all(t is not None for t in temps)
+    x = np.array(temps, float) if by_temperature else np.arange(len(groups), dtype=float)
+    order = np.argsort(x, kind="stable")
+    fig = Figure(figsize=(8, 7))
+    ax_s, ax_t = fig.subplots(2, 1, sharex=True)
+    rated = all("tension_percent_rated" in ds for _, ds in groups)
+    tension = "tension_percent_rated" if rated else "horizontal_tension_along_chord"
+    for cab in (str(c) for c in groups[0][1].cable.values):
+        for var, style in (("sag_midspan", "-"), ("sag_lowest_point", "--")):
+            y = np.array([float(ds[var].sel(cable=cab)) for _, ds in groups])
+            ax_s.plot(x[order], y[order], style, marker="o", label=f"{cab}, {var}",
+                      gid=f"{cab}|{var}")
+        y = np.array([float(ds[tension].sel(cable=cab)) for _, ds in groups])
+        ax_t.plot(x[order], y[order], marker="o", label=cab, gid=f"{cab}|{tension}")
+    ax_s.set_ylabel("sag [m]")
+    ax_s.set_title("sag at midspan (solid) and of the lowest point below the lower end (dashed)",
+                   fontsize="medium")
+    ax_t.set_ylabel("largest tension [% of rated strength]" if rated
+                    else "horizontal tension along the chord [N]")
+    if by_temperature:
+        ax_t.set_xlabel("temperature (the case's reference_temperature units)")
+    else:
+        ax_t.set_xticks(x, [name for name, _ in groups], rotation=30)
+        ax_t.set_xlabel("static step")
+    for ax in (ax_s, ax_t):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small")
+    fig.suptitle(tree.attrs.get("title", ""), fontsize="medium")
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,58 @@
+"""A real ``python -m catdae`` process and signals sent to it once it shows that it runs (shared
+by tests/unit/test_interrupts.py and tests/scenes/test_extremes.py): no fixed sleeps, generous
+timeouts."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import threading
+import time
+
+
+def catdae_process(args, cwd, *, snapshot_seconds=None):
+    """``python -m catdae ARGS``; with ``snapshot_seconds`` the same command line with the
+    transient snapshot interval lowered (catdae.solvers.transient.INCREMENT_SECONDS, 20 s)."""
+    if snapshot_seconds is None:
+        cmd = [sys.executable, "-m", "catdae", *args]
+    else:
+        code = ("import sys, catdae.solvers.transient as t, catdae.cli as c; "
+                f"t.INCREMENT_SECONDS = {snapshot_seconds!r}; sys.exit(c.main(sys.argv[1:]))")
+        cmd = [sys.executable, "-c", code, *args]
+    return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd,
+                            env=dict(os.environ, PYTHONUNBUFFERED="1"))
+
+
+def signal_when(proc, sig, ready, timeout=180.0) -> tuple[int, str]:
+    """Send ``sig`` once ``ready(stderr so far)`` holds; return (exit code, stderr)."""
+    chunks: list[bytes] = []
+
+    def read_err():
+        while b := proc.stderr.read1(4096):
+            chunks.append(b)
+
+    reader = threading.Thread(target=read_err, daemon=True)
+    reader.start()
+    try:
+        deadline = time.monotonic() + timeout
+        while not ready(b"".join(chunks).decode(errors="replace")):
+            assert proc.poll() is None, b"".join(chunks).decode(errors="replace")
+            assert time.monotonic() < deadline, b"".join(chunks).decode(errors="replace")
+            time.sleep(0.05)
+        proc.send_signal(sig)
+        code = proc.wait(120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    reader.join(10)
+    proc.stderr.close()
+    return code, b"".join(chunks).decode(errors="replace")
+
+
+def transient_runs(err: str) -> bool:
+    """The progress bar of the transient step shows that it has passed t = 1 s."""
+    shown = re.findall(r"dyn:.*?t=([0-9.]+)/", err)
+    return bool(shown) and float(shown[-1]) > 1.0

@@ -1,0 +1,104 @@
+"""Clearance of a span above ``[ground]`` (issue 23): a level ground at an elevation, or a
+profile of heights z at x. The reference is Irvine's elastic catenary (tests/reference.py), its
+curve x(s), z(s) searched here for the least height above the ground."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+import catdae
+from catdae.cli import main
+from catdae.errors import CaseError
+
+from reference import irvine_catenary
+
+EA, MASS, G, L0 = 2.0e7, 2.0, 9.81, 104.0
+
+CASE = f"""
+[materials.m]
+EA = {EA!r}
+mass = {MASS!r}
+[nodes]
+A = [0.0, 0.0, 30.0]
+B = [100.0, 0.0, 50.0]
+[supports]
+A = "pinned"
+B = "pinned"
+[[cables]]
+name = "c"
+ends = ["A", "B"]
+material = "m"
+length = {L0!r}
+elements = 8
+{{ground}}
+[[steps]]
+kind = "static"
+name = "st"
+[[steps]]
+kind = "transient"
+name = "sway"
+duration = 0.3
+output_interval = 0.01
+"""
+
+
+def least_gap(ground):
+    ref = irvine_catenary(100.0, 20.0, L0, EA, MASS * G)
+
+    def gap(s):
+        x, z = ref["x"](np.atleast_1d(s))
+        return float(30.0 + z[0] - ground(x[0]))
+
+    s = np.linspace(0.0, L0, 2001)
+    x, z = ref["x"](s)
+    k = int(np.argmin(30.0 + z - np.array([ground(v) for v in x])))
+    best = minimize_scalar(gap, bounds=(s[max(k - 1, 0)], s[min(k + 1, s.size - 1)]),
+                           method="bounded", options={"xatol": 1e-12})
+    return best.fun, best.x
+
+
+@pytest.mark.parametrize(("table", "ground"), [
+    ("[ground]\nelevation = 12.5", lambda x: 12.5),
+    ("[ground]\nx = [-10.0, 40.0, 120.0]\nz = [5.0, 20.0, 33.0]",
+     lambda x: float(np.interp(x, [-10.0, 40.0, 120.0], [5.0, 20.0, 33.0]))),
+])
+def test_clearance_against_the_catenary(table, ground):
+    tree = catdae.run(catdae.load_case(CASE.format(ground=table)), progress=False)
+    st = tree["st"].ds.sel(cable="c")
+    gap, s = least_gap(ground)
+    assert float(st.clearance) == pytest.approx(gap, rel=1e-9)
+    assert float(st.clearance_s) == pytest.approx(s, abs=1e-4)
+    tr = tree["sway"].ds
+    # transient: the least over the output times at the nodes
+    height = tr.position.sel(axis="z").values - np.vectorize(ground)(
+        tr.position.sel(axis="x").values)
+    assert float(tr.clearance.sel(cable="c")) == pytest.approx(height.min(), rel=1e-14)
+    k_t = np.unravel_index(np.argmin(height), height.shape)[0]
+    assert float(tr.clearance_time.sel(cable="c")) == tr.time.values[k_t]
+
+
+@pytest.mark.parametrize(("table", "where", "words"), [
+    ("[ground]\nelevation = 1.0\nx = [0.0, 1.0]\nz = [0.0, 0.0]", "ground", "not both"),
+    ("[ground]", "ground", "not neither"),
+    ("[ground]\nx = [0.0, 1.0]", "ground.z", "missing"),
+    ("[ground]\nx = [0.0, 0.0]\nz = [1.0, 2.0]", "ground.x", "strictly increasing"),
+    ("[ground]\nx = [0.0, 1.0, 2.0]\nz = [1.0, 2.0]", "ground", "same length"),
+])
+def test_bad_grounds(table, where, words, tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text(CASE.format(ground=table))
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{where}:" in err and words in err, err
+    with pytest.raises(CaseError):
+        catdae.load_case(path)
+
+
+def test_a_profile_needs_gravity_along_minus_z():
+    text = "gravity = [0.0, -9.81, 0.0]\n" + CASE.format(
+        ground="[ground]\nx = [0.0, 1.0]\nz = [0.0, 0.0]").replace(
+        'B = "pinned"', 'B = "pinned"')
+    with pytest.raises(CaseError, match="needs gravity along -z"):
+        catdae.load_case(text)

@@ -1,0 +1,132 @@
+"""The line engineer's three scenes of issue 23, from ``catdae run`` and ``catdae plot`` alone
+(the bundled cases), each against its closed form or hand calculation (docs/theory.md §14):
+
+- the Drake sag-temperature table (cases/drake_sag_temperature.toml): the elastic catenary of a
+  level span with a thermal strain (Irvine 1981 §2.2), solved here by brentq;
+- the wind swing (cases/conductor_wind_swing.toml): under its weight w and a uniform wind p
+  the span hangs in the plane of the resultant, swung by atan(p/w), where it is the elastic
+  catenary under sqrt(w² + p²) (Irvine's, tests/reference.py);
+- the ice-shedding jump (cases/ice_shedding.toml): a taut span moves as a string whose
+  symmetric modes have frequencies k f1, so half a period 1/(2 f1) after the ice drops it is
+  the mirror image of its iced shape about the bare one: the jump above the bare position is
+  the sag the ice added.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import catdae
+from catdae.cli import main
+from catdae.output import plot_spans
+
+from reference import irvine_catenary
+from repo_paths import CASES
+
+G = 9.81
+
+
+def level_span(L0, EA, w, eps_t, span):
+    """(sag at midspan, H) of an elastic catenary of unstrained length L0 between level
+    supports ``span`` apart, weight w per unstrained metre, stretch 1 + eps_t + T/EA
+    (Irvine 1981, §2.2 with a thermal strain): span = H L0/EA + (1 + eps_t) (2H/w)
+    asinh(w L0/(2H)), sag = (1 + eps_t) (sqrt(H² + (w L0/2)²) - H)/w + w L0²/(8 EA)."""
+    def gap(H):
+        return H * L0 / EA + (1.0 + eps_t) * 2.0 * H / w * math.asinh(w * L0 / (2.0 * H)) - span
+    H = brentq(gap, 1e-6 * w * L0, 1e3 * w * L0, xtol=1e-13, rtol=1e-15)
+    return (1.0 + eps_t) * (math.hypot(H, 0.5 * w * L0) - H) / w + w * L0**2 / (8.0 * EA), H
+
+
+def run_and_plot(case, tmp_path, what):
+    out = tmp_path / f"{case.stem}.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    assert main(["plot", str(out), "-o", str(tmp_path / "plots"), "--what", *what]) == 0
+    return catdae.read_results(out)
+
+
+def test_drake_sag_temperature_table(tmp_path):
+    case = CASES / "drake_sag_temperature.toml"
+    tree = run_and_plot(case, tmp_path, ["spans"])
+    assert (tmp_path / "plots" / "spans.png").is_file()
+    c = catdae.load_case(case)
+    mat = c.materials["drake"]
+    w, ref = mat.mass * G, c.reference_temperature
+    steps = [s for s in c.steps]
+    assert len(steps) == 12 and ref == 15.0
+    L0 = float(tree["strung"].ds.unstrained_length.sel(cable="span"))
+    # the stringing target holds in the closed form with the length found
+    assert level_span(L0, mat.EA, w, 0.0, 300.0)[1] == pytest.approx(28020.0, rel=1e-9)
+    fig = plot_spans.spans(tree)
+    drawn = {ln.get_gid(): ln for ax in fig.axes for ln in ax.get_lines()}
+    temps = sorted(float(tree[s.name].ds.attrs["temperature"]) for s in steps)
+    np.testing.assert_array_equal(drawn["span|sag_midspan"].get_xdata(), temps)
+    table = []
+    for step in steps:
+        ds = tree[step.name].ds
+        T = float(ds.attrs["temperature"])
+        sag, H = level_span(L0, mat.EA, w, mat.thermal_expansion * (T - ref), 300.0)
+        got = ds.sel(cable="span")
+        assert float(got.sag_midspan) == pytest.approx(sag, rel=1e-9), T
+        assert float(got.sag_lowest_point) == pytest.approx(sag, rel=1e-9), T
+        assert float(got.horizontal_tension_along_chord) == pytest.approx(H, rel=1e-9), T
+        end = math.hypot(H, 0.5 * w * L0)  # the support carries half the weight
+        assert float(got.tension_percent_rated) == pytest.approx(100 * end / 140.1e3, rel=1e-9)
+        assert float(got.swing_angle) == pytest.approx(0.0, abs=1e-9)
+        assert float(got.clearance) == pytest.approx(30.0 - sag, rel=1e-9)  # ground at 0
+        table.append((T, sag))
+    table.sort()
+    y = drawn["span|sag_midspan"].get_ydata()
+    np.testing.assert_allclose(y, [s for _, s in table], rtol=1e-12)
+    assert np.all(np.diff(y) > 0)  # hotter, longer, lower
+
+
+def test_wind_swing_angle(tmp_path):
+    case = CASES / "conductor_wind_swing.toml"
+    tree = run_and_plot(case, tmp_path, ["spans", "profile"])
+    c = catdae.load_case(case)
+    mat = c.materials["drake"]
+    w, p = mat.mass * G, 8.43
+    L0 = float(tree["still"].ds.unstrained_length.sel(cable="span"))
+    windy = tree["windy"].ds.sel(cable="span")
+    phi = math.degrees(math.atan(p / w))  # 27.83 deg
+    tilted = irvine_catenary(300.0, 0.0, L0, mat.EA, math.hypot(w, p))
+    # the wind acts at Gauss points, the weight exactly: O(h²), 40 elements
+    assert float(windy.swing_angle) == pytest.approx(phi, rel=1e-5)
+    assert float(windy.horizontal_tension_along_chord) == pytest.approx(tilted["H"], rel=1e-5)
+    assert float(windy.sag_midspan) == pytest.approx(
+        tilted["sag"] * math.cos(math.radians(phi)), rel=1e-5)
+    # the printed horizontal tension holds the wind's share at the support as well
+    assert float(windy.horizontal_tension) == pytest.approx(
+        math.hypot(float(windy.horizontal_tension_along_chord), p * L0 / 2), rel=1e-9)
+    assert float(tree["still"].ds.swing_angle.sel(cable="span")) == pytest.approx(0, abs=1e-9)
+
+
+def test_ice_shedding_jump(tmp_path):
+    case = CASES / "ice_shedding.toml"
+    tree = run_and_plot(case, tmp_path, ["history"])
+    c = catdae.load_case(case)
+    mat = c.materials["steel"]
+    w, ice = mat.mass * G, 5.0
+    L0 = float(tree["bare"].ds.unstrained_length.sel(cable="wire"))
+    bare = level_span(L0, mat.EA, w, 0.0, 60.0)
+    iced = level_span(L0, mat.EA, w + ice, 0.0, 60.0)
+    sags = [float(tree[k].ds.sag_midspan.sel(cable="wire")) for k in ("bare", "iced")]
+    assert sags[0] == pytest.approx(bare[0], rel=1e-9)
+    assert sags[1] == pytest.approx(iced[0], rel=1e-4)  # the ice at Gauss points: O(h²)
+    ds = tree["shedding"].ds
+    assert ds.attrs["jump_reference"] == "bare"
+    jump = ds.sel(cable="wire")
+    # the mirror of a string: the jump is the sag the ice added, half a period after it drops
+    f1 = math.sqrt(bare[1] / mat.mass) / (2 * 60.0)  # taut string, Irvine's λ² = 0.002
+    assert float(jump.jump_height) == pytest.approx(iced[0] - bare[0], rel=3e-3)
+    assert float(jump.jump_time) == pytest.approx(0.5 / f1, rel=2e-2)
+    assert float(jump.jump_s) == pytest.approx(L0 / 2, abs=L0 / 24)
+    # the envelope of the midspan's vertical displacement holds the same peak
+    dz = float(ds.displacement_max.sel(node="wire.12", axis="z")
+               - tree["bare"].ds.displacement.sel(node="wire.12", axis="z"))
+    assert dz == pytest.approx(float(jump.jump_height), rel=1e-12)
+    assert float(ds.displacement_max_time.sel(node="wire.12", axis="z")) == float(jump.jump_time)

@@ -1,0 +1,91 @@
+"""What ``catdae run`` prints (issue 23, defect 5): every frequency of a modal step with its
+labels, and a horizontal tension that says what it includes.
+
+A level span under its weight w and a wind p across it hangs in the plane of the resultant
+load, tilted by atan(p/w): there it is a catenary under sqrt(w² + p²) (Irvine's, from
+tests/reference.py), whose horizontal tension is the component along the chord; the horizontal
+part of the end tension adds the wind's share p L0/2 across the span.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import pytest
+
+import catdae
+from catdae.cli import main
+
+from reference import irvine_catenary
+
+EA, MASS, G, WIND, L0 = 2.0e7, 1.6, 9.81, 9.0, 101.0
+
+CASE = f"""
+title = "wind"
+[materials.m]
+EA = {EA!r}
+mass = {MASS!r}
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [100.0, 0.0, 0.0]
+[supports]
+A = "pinned"
+B = "pinned"
+[[cables]]
+name = "span"
+ends = ["A", "B"]
+material = "m"
+length = {L0!r}
+elements = 12
+[[distributed_loads]]
+cable = "span"
+load = [0.0, {WIND!r}, 0.0]
+[[steps]]
+kind = "static"
+name = "windy"
+[[steps]]
+kind = "modal"
+name = "modes"
+modes = 12
+"""
+
+
+@pytest.fixture(scope="module")
+def printed(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("summary")
+    case = folder / "wind.toml"
+    case.write_text(CASE)
+    out = folder / "wind.nc"
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    return buf.getvalue(), catdae.read_results(out)
+
+
+def test_every_frequency_is_printed_with_its_labels(printed):
+    text, tree = printed
+    md = tree["modes"].to_dataset()
+    rows = re.findall(r"^ +mode (\d+): ([0-9.e+-]+) Hz, (.*)$", text, re.M)
+    assert len(rows) == 12 == md.mode.size, text
+    for (k, f, labels), mode in zip(rows, md.mode.values, strict=True):
+        assert int(k) == int(mode)
+        assert float(f) == pytest.approx(float(md.frequency.sel(mode=mode)), rel=1e-5)
+        assert labels == (f"{md.plane.sel(mode=mode).item()}, "
+                          f"{md.symmetry.sel(mode=mode).item()}")
+
+
+def test_the_horizontal_tension_says_what_it_includes(printed):
+    text, tree = printed
+    ds = tree["windy"].to_dataset()
+    tilted = irvine_catenary(100.0, 0.0, L0, EA, math.hypot(MASS * G, WIND))
+    along = float(ds.horizontal_tension_along_chord.sel(cable="span"))
+    whole = float(ds.horizontal_tension.sel(cable="span"))
+    assert along == pytest.approx(tilted["H"], rel=2e-4)  # wind at Gauss points: O(h²)
+    assert whole == pytest.approx(math.hypot(along, WIND * L0 / 2), rel=1e-9)
+    line = next(s for s in text.splitlines() if s.strip().startswith("cable span"))
+    assert f"horizontal tension {whole:.6g} N at A (includes the part across the chord)" in line
+    assert f"along the chord {along:.6g} N" in line
