@@ -7,6 +7,7 @@ keeps everything computed before it: the exception carries the partial result tr
 
 from __future__ import annotations
 
+import copy
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -16,6 +17,8 @@ import numpy as np
 from catdae._xr import xr
 from catdae.case import Case, Step, load_case
 from catdae.case.frame import rotate_back, to_gravity_frame
+from catdae.case.sweep import apply_sweep
+from catdae.case.sweep import units as sweep_units
 from catdae.element.elements import NOT_CONVERGED
 from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutputError
 from catdae.interrupts import deferred
@@ -24,8 +27,10 @@ from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
 from catdae.model.span import span_quantities
 from catdae.output import engineering, results
+from catdae.output.connectors import with_connector_forces, with_damped_modes
 from catdae.output.transient import as_dataset
-from catdae.solvers.modal import solve_modal
+from catdae.solvers.damped_modes import solve_damped
+from catdae.solvers.modal import classify, solve_modal
 from catdae.solvers.static import solve_static
 
 
@@ -80,6 +85,9 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
             if find_forms and step.kind == "static":
                 local, mesh, model, ds = _form_step(step, local, absent, temperature, state)
                 find_forms = False
+            elif step.sweep is not None:
+                ds, temperature = _sweep_step(step, local, mesh, absent, temperature, state,
+                                              progress)
             else:
                 model = Model(local, mesh.heated(local, temperature), absent,
                               mass_model=step.mass_model, kind=step.kind)
@@ -133,6 +141,9 @@ def check_steps(case: Case, mesh) -> None:
     Raises CaseError with the step's field path.
     """
     problems = []
+    if case.steps and case.steps[0].sweep is not None and formfind.pending(case):
+        problems.append(("steps[0].sweep", "the first static step finds the cables' lengths "
+                         "(form-finding) and cannot be swept; sweep a later step"))
     absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
               if not x.active}
     for i, step in enumerate(case.steps):
@@ -151,6 +162,33 @@ def check_steps(case: Case, mesh) -> None:
                              "cable's material a mass > 0 or put a point mass there"))
     if problems:
         raise CaseError(case.path, problems)
+
+
+def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, state: _State,
+                progress) -> tuple[xr.Dataset, float | dict]:
+    """The step run once per value of its sweep (catdae.case.sweep), each from the same
+    starting state, as one dataset with a ``sweep`` dimension. Attributes that differ between
+    the values become arrays over them (numbers) or their texts joined by " | ". The state and
+    temperature after it are those of the last value. Returns (dataset, temperature)."""
+    start = copy.deepcopy(state)
+    groups = []
+    for value in step.sweep.values:
+        case_v, step_v = apply_sweep(case, step, value)
+        temp_v = temperature if step_v.temperature_change is None else step_v.temperature_change
+        run_state = copy.deepcopy(start)
+        model = Model(case_v, mesh.heated(case_v, temp_v), absent, mass_model=step.mass_model,
+                      kind=step.kind)
+        groups.append(_run_step(step_v, model, run_state, None, progress))
+    state.__dict__.update(run_state.__dict__)
+    field = step.sweep.field
+    ds = xr.concat(groups, dim="sweep", combine_attrs="drop_conflicts")
+    for key in {k for g in groups for k in g.attrs} - set(ds.attrs):  # differ by value
+        values = [g.attrs.get(key, "") for g in groups]
+        numbers = all(isinstance(v, int | float | np.number) for v in values)
+        ds.attrs[key] = np.array(values) if numbers else " | ".join(map(str, values))
+    ds = ds.assign_coords(sweep=xr.Variable("sweep", np.array(step.sweep.values), {
+        "units": sweep_units(field), "long_name": f"swept value of {field}"}))
+    return ds.assign_attrs(sweep_field=field), temp_v
 
 
 def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.Dataset:
@@ -193,6 +231,7 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
          "load_increments": sol.load_steps, "status": "completed"},
         cables=model.cable_summary(sol.X, sol.state),
     )
+    ds = with_connector_forces(ds, model.connectors, sol.X)
     return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
                                   engineering.rated_strengths(model.case, model.mesh.cable_names))
 
@@ -222,11 +261,18 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
         raise ConvergenceError(f"modal step '{step.name}': an element cannot be solved in the "
                                "current configuration")
     sol = solve_modal(model, state.X, est, step.modes)
-    return results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
-                                 {"solver": sol.solver, "mass_model": model.mass_model.name,
-                                  "mass_model_setting": model.mass_model.setting,
-                                  "mass_model_choice": model.mass_model.choice,
-                                  "status": "completed"})
+    ds = results.modal_dataset(model.mesh, sol.frequency, sol.shape, sol.plane, sol.symmetry,
+                               {"solver": sol.solver, "mass_model": model.mass_model.name,
+                                "mass_model_setting": model.mass_model.setting,
+                                "mass_model_choice": model.mass_model.choice,
+                                "status": "completed"})
+    damped = solve_damped(model, state.X, est, step.modes, step.damping)
+    if damped is not None:  # docs/theory.md §16
+        modes, shapes = damped
+        plane, symmetry = classify(model, state.X, shapes.real)
+        ds = with_damped_modes(ds, modes, shapes, plane, symmetry).assign_attrs(
+            damped_solver=modes.solver)
+    return ds
 
 
 def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:

@@ -206,47 +206,74 @@ def _export(args) -> int:
 
 
 def summary(tree) -> str:
-    """A short printed summary: per step, what a user looks at first."""
+    """A short printed summary: per step, what a user looks at first (per value of a sweep)."""
     lines = [f"{tree.attrs.get('title') or 'catdae run'}"]
     for name, node in tree.children.items():
         ds = node.to_dataset()
-        kind = ds.attrs.get("kind", "")
-        if kind == "static":
-            hot = (f" at {ds.attrs['temperature']:.6g} deg" if "temperature" in ds.attrs
-                   else "")
-            lines.append(f"[{name}] static{hot}: {ds.attrs.get('iterations')} Newton "
-                         f"iterations, residual {ds.attrs.get('residual_norm', 0):.2e} N")
-            lines.extend(_cable_lines(ds))
-        elif kind == "modal":
-            lines.extend(_mode_lines(name, ds))
-        elif kind == "transient":
-            a = ds.attrs
-            lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
-                         f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
-                         f"{a.get('n_residual_evaluations')} residuals, "
-                         f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
-            # supports (reaction defined on some axis) are prescribed: the free nodes' motion
-            free = ds.reaction.isnull().all(("time", "axis"))
-            d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
-                else ds.displacement
-            mag = np.sqrt((d**2).sum("axis"))
-            node = str(mag.max("time").idxmax("node").values)
-            lines.append(f"    largest motion of a free node at {node}: "
-                         f"{float(mag.sel(node=node).max()):.4g} m; "
-                         f"max tension {float(ds.tension.max()):.6g} N")
-            lines.extend(_jump_lines(ds))
-            if a.get("note"):
-                lines.append(f"    note: {a['note']}")
+        if "sweep" not in ds.dims:
+            lines.extend(_step_lines(name, ds))
+            continue
+        field = ds.attrs.get("sweep_field", "sweep")
+        lines.append(f"[{name}] swept over {field}: {ds.sizes['sweep']} values")
+        n = ds.sizes["sweep"]
+        for k, value in enumerate(ds.sweep.values):
+            one = ds.isel(sweep=k)
+            one.attrs = {key: v[k] if np.ndim(v) == 1 and len(v) == n else
+                         v.split(" | ")[k] if isinstance(v, str) and v.count(" | ") == n - 1
+                         else v for key, v in ds.attrs.items()}
+            lines.extend(_step_lines(f"{name} {field} = {float(value):.6g}", one))
     return "\n".join(lines)
 
 
+def _step_lines(name: str, ds) -> list[str]:
+    """The summary of one step's dataset (of one value of a sweep)."""
+    lines = []
+    kind = ds.attrs.get("kind", "")
+    if kind == "static":
+        hot = (f" at {ds.attrs['temperature']:.6g} deg" if "temperature" in ds.attrs
+               else "")
+        lines.append(f"[{name}] static{hot}: {ds.attrs.get('iterations')} Newton "
+                     f"iterations, residual {ds.attrs.get('residual_norm', 0):.2e} N")
+        lines.extend(_cable_lines(ds))
+    elif kind == "modal":
+        lines.extend(_mode_lines(name, ds))
+    elif kind == "transient":
+        a = ds.attrs
+        lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
+                     f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
+                     f"{a.get('n_residual_evaluations')} residuals, "
+                     f"{a.get('wall_time', 0):.2f} s wall, status {a.get('status')}")
+        # supports (reaction defined on some axis) are prescribed: the free nodes' motion
+        free = ds.reaction.isnull().all(("time", "axis"))
+        d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
+            else ds.displacement
+        mag = np.sqrt((d**2).sum("axis"))
+        node = str(mag.max("time").idxmax("node").values)
+        top = (f"; max tension {float(ds.tension.max()):.6g} N" if ds.sizes.get("element")
+               else "")  # a scene of connectors alone has no cable element
+        lines.append(f"    largest motion of a free node at {node}: "
+                     f"{float(mag.sel(node=node).max()):.4g} m{top}")
+        lines.extend(_jump_lines(ds))
+        if a.get("note"):
+            lines.append(f"    note: {a['note']}")
+    return lines
+
+
 def _mode_lines(name: str, ds) -> list[str]:
-    """Every mode of a modal step: its frequency and labels (plane, symmetry)."""
-    out = [f"[{name}] modal: {ds.mode.size} modes"]
+    """Every mode of a modal step: its frequency and labels (plane, symmetry); with damping
+    the damped frequency, the damped modes' labels and the damping ratio."""
+    damped = "damping_ratio" in ds
+    out = [f"[{name}] modal: {ds.mode.size} modes"
+           + (" (damped: frequency Im s/2π, damping ratio -Re s/|s|)" if damped else "")]
+    names = ("damped_plane", "damped_symmetry") if damped else ("plane", "symmetry")
     for k, mode in enumerate(ds.mode.values):
-        labels = ", ".join(str(ds[v].values[k]) for v in ("plane", "symmetry") if v in ds)
-        out.append(f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
-                   + (f", {labels}" if labels else ""))
+        labels = ", ".join(str(ds[v].values[k]) for v in names if v in ds)
+        line = (f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
+                + (f", {labels}" if labels else ""))
+        if damped:
+            line += (f", damping ratio {float(ds.damping_ratio.values[k]):.4g} (undamped "
+                     f"{float(ds.undamped_frequency.values[k]):.6g} Hz)")
+        out.append(line)
     return out
 
 

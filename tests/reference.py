@@ -11,6 +11,7 @@ Contents
 ``irvine_symmetric_roots``      roots of Irvine & Caughey's symmetric in-plane frequency equation.
 ``irvine_caughey_frequencies``  linear free-vibration frequencies of a shallow level cable (Hz).
 ``taut_string_frequencies``     frequencies of a weightless taut string (Hz).
+``string_with_damper``          exact eigenvalue of a taut string with a viscous damper.
 ``level_catenary_midspan``      midspan of a level elastic catenary with a thermal strain.
 
 Formulation of the statics (chosen to differ from the package's: origin at support i, unknowns H and
@@ -374,6 +375,48 @@ def piecewise_catenary(span: float, dz: float, EA: float, pieces) -> dict:
         raise RuntimeError(f"piecewise catenary residual {residual:.3e} m too large")
     return {"H": H, "V_i": V, "V_j": V + float((w * L).sum()),
             "position": lambda s: position(s, H, V), "residual": residual}
+
+
+def string_with_damper(a_over_l: float, eta: float, mode: int = 1) -> complex:
+    """The exact eigenvalue γ L (γ = s / c_w, s the Laplace variable) of a taut string of
+    length L with a viscous damper at distance a from one end (Krenk 2000, J. Appl. Mech.
+    67, 772-776):
+
+        coth(γ a) + coth(γ (L - a)) + η = 0,     η = c / √(T m),
+
+    followed by continuation in η from the undamped root γ L = i n π. The damping ratio is
+    -Re γ / |γ|, the damped frequency Im γ c_w / 2π."""
+    x1, x2 = a_over_l, 1.0 - a_over_l
+
+    def f(g):
+        return 1.0 / np.tanh(g * x1) + 1.0 / np.tanh(g * x2)
+
+    def df(g):
+        return -x1 / np.sinh(g * x1) ** 2 - x2 / np.sinh(g * x2) ** 2
+
+    g = 1j * mode * np.pi
+    if eta == 0.0:
+        return complex(g)
+    etas = np.concatenate([np.geomspace(1e-4 * min(eta, 1.0), eta, 400)])
+    for e in etas:
+        for _ in range(50):
+            step = (f(g) + e) / df(g)
+            g = g - step
+            if abs(step) < 1e-14 * abs(g):
+                break
+    return complex(g)
+
+
+def damper_sag_reduction(lambda2: float) -> float:
+    """R = 1 - 3 (λ²/ω̄) dω̄/dλ² for the first symmetric in-plane mode (Irvine's root): the
+    relative frequency shift when a point at a ≪ L is locked, over that of a taut string, to
+    first order in a/L. The largest damping ratio a damper there can give is about ½ (a/L) R
+    (docs/theory.md §16; the argument is the document's own, the roots Irvine's)."""
+    h = 1e-4 * lambda2
+    w = irvine_symmetric_roots(lambda2, 1)[0]
+    dw = (irvine_symmetric_roots(lambda2 + h, 1)[0]
+          - irvine_symmetric_roots(lambda2 - h, 1)[0]) / (2 * h)
+    return 1.0 - 3.0 * lambda2 / w * dw
 
 
 def level_catenary_midspan(L0, EA, w, eps_t, span=None):

@@ -17,6 +17,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
+from catdae.case.build_connectors import _ConnectorsPass, connector_ends
 from catdae.case.build_fluid import _FluidPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
@@ -39,10 +40,12 @@ from catdae.case.schema import (
     _PointMass,
     _Top,
 )
+from catdae.case.sweep import _SweepPass
 from catdae.errors import CaseError
 
 
-class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _GroundPass):
+class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, _FluidPass,
+               _GroundPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -98,16 +101,20 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _GroundPass):
         supports = self.supports(top.supports, nodes)
         self.gravity_supports(supports)
         cables = self.cables(top.cables, materials, nodes)
-        if not top.cables and "cables" not in bad:
+        self.cable_ends |= connector_ends(top)  # what a connector holds is held
+        held = top.cables or top.springs or top.dampers or top.bars
+        if not held and "cables" not in bad:
             self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "
                          '(name, ends = ["A", "B"], material, length)')
         for key in sorted(self.node_names - self.cable_ends - self.support_names):
-            if top.cables:
+            if held:
                 self.problem(("nodes", key), f"node {key!r} is not an end of any cable and "
                              "not supported: nothing holds it (remove it, or use it)")
         point_masses = self.located(top.point_masses, "point_masses", _PointMass, cables, nodes)
         loads = self.located(top.loads, "loads", _Load, cables, nodes)
         distributed = self.distributed(top.distributed_loads, cables)
+        connectors = self.connectors(top, cables, nodes)
+        self.connector_items = connectors  # what a step's sweep may vary
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         self.reference_temperature = top.reference_temperature
@@ -127,8 +134,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _GroundPass):
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            steps=tuple(steps), water=water, air=air, path=self.path, text=text, name=name,
-            reference_temperature=top.reference_temperature, ground=ground,
+            **connectors, steps=tuple(steps), water=water, air=air, path=self.path, text=text,
+            name=name, reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -141,7 +148,8 @@ class _Builder(_CablesPass, _StepsPass, _TimePass, _FluidPass, _GroundPass):
         found: list[tuple[tuple, str]] = [(("title",), top.title), (("source",), top.source)]
         found += [(("materials", k), k) for k in top.materials]
         found += [(("nodes", k), k) for k in top.nodes]
-        for section in ("cables", "point_masses", "loads", "distributed_loads"):  # steps:
+        for section in ("cables", "point_masses", "loads", "distributed_loads", "springs",
+                        "dampers", "bars"):  # steps:
             # their names are held to the stricter rule of group names (steps())
             found += [((section, i, "name"), item["name"]) for i, item in
                       enumerate(getattr(top, section)) if isinstance(item.get("name"), str)]

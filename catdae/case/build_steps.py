@@ -151,7 +151,8 @@ class _StepsPass:
             if kind == "static":
                 extra = {"load_steps": v.load_steps}
             elif kind == "modal":
-                extra = {"modes": v.modes, "mass_model": v.mass_model}
+                extra = {"modes": v.modes, "mass_model": v.mass_model,
+                         "damping": None if v.damping is None else self.damping(v.damping, where)}
             else:
                 if v.output_interval > v.duration:
                     self.problem(where + ("output_interval",), "expected at most the step "
@@ -168,10 +169,11 @@ class _StepsPass:
                          "mass_model": v.mass_model, "inertia": v.inertia,
                          "jump_reference": self.jump_reference(v, where, out)}
             temperature = self.step_temperature(v, where)
-            if complete and temperature is not False:
+            sweep = self.sweep(v.sweep, where, self.connector_items)
+            if complete and temperature is not False and sweep is not False:
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
                                 add=tuple(v.add), temperature_change=temperature,
-                                **extra))
+                                sweep=sweep, **extra))
         return out
 
     def step_temperature(self, v: Any, where: tuple) -> float | FrozenMap | None | bool:

@@ -14,11 +14,13 @@ from typing import Any, Literal
 
 from pydantic import ValidationError
 
+from catdae.case.build_connectors import Bar, Damper, Spring
 from catdae.case.fluid import Air, Water
 from catdae.case.limits import size_problems
 from catdae.case.messages import _message
 from catdae.case.names import mesh_node, split_mesh_node
 from catdae.case.schema import _Overrides
+from catdae.case.sweep import Sweep
 from catdae.case.timefunc import TimeFunction
 from catdae.errors import CaseError
 
@@ -249,6 +251,7 @@ class Step:
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     temperature_change: float | Mapping[str, float] | None = None
     jump_reference: str | None = None  # transient: an earlier static step (jump_height)
+    sweep: Sweep | None = None
 
     def __post_init__(self):
         if isinstance(self.temperature_change, Mapping):
@@ -279,6 +282,9 @@ class Case:
     loads: tuple[Load, ...] = ()
     distributed_loads: tuple[DistributedLoad, ...] = ()
     support_motions: tuple[SupportMotion, ...] = ()
+    springs: tuple[Spring, ...] = ()
+    dampers: tuple[Damper, ...] = ()
+    bars: tuple[Bar, ...] = ()
     steps: tuple[Step, ...] = ()
     reference_temperature: float | None = None  # °C: where lengths hold (steps' temperature)
     ground: Any = None  # catdae.case.ground.Ground: clearance results
@@ -292,7 +298,7 @@ class Case:
         for key in ("materials", "nodes", "supports"):
             object.__setattr__(self, key, FrozenMap(getattr(self, key)))
         for key in ("cables", "point_masses", "loads", "distributed_loads", "support_motions",
-                    "steps"):
+                    "springs", "dampers", "bars", "steps"):
             object.__setattr__(self, key, tuple(getattr(self, key)))
 
     def cable(self, name: str) -> Cable:
@@ -362,8 +368,26 @@ class Case:
 
             point_masses = tuple(keep_place(p) for p in point_masses)
             loads = tuple(keep_place(p) for p in loads)
+
+            def keep_end(ref: str, what: str) -> str:  # a connector's end on a mesh node
+                if ref in self.nodes:
+                    return ref
+                cable, k = split_mesh_node(ref)
+                k_new = int(k) * int(elements) / by_name[cable].elements
+                if k_new != int(k_new):
+                    raise CaseError(self.path, [("elements", (
+                        f"{what} ends on mesh node {ref!r}, which with {elements} elements would "
+                        f"fall between mesh nodes: use a multiple of "
+                        f"{by_name[cable].elements} elements"))])
+                return mesh_node(cable, k_new)
+
+            connectors = {section: tuple(
+                replace(x, ends=tuple(keep_end(e, f"{section}.{x.name}") for e in x.ends))
+                for x in getattr(self, section)) for section in ("springs", "dampers", "bars")}
+        else:
+            connectors = {}
         case = replace(self, steps=steps, cables=cables, point_masses=point_masses,
-                       loads=loads)
+                       loads=loads, **connectors)
         problems = size_problems(case)  # more elements: the limits are judged again
         if problems:
             raise CaseError(self.path, problems)

@@ -42,6 +42,9 @@ class _Top(BaseModel):
     loads: list[TomlTable] = []
     distributed_loads: list[TomlTable] = []
     support_motions: list[TomlTable] = []
+    springs: list[TomlTable] = []  # connectors: validated by build_connectors
+    dampers: list[TomlTable] = []
+    bars: list[TomlTable] = []
     steps: list[TomlTable] = []
     water: Any = None  # [water] and [air]: checked by build_fluid
     air: Any = None
@@ -126,6 +129,7 @@ class _StaticStep(BaseModel):
     temperature: Any = None  # with the case's reference_temperature
     add: list[Name] = []
     load_steps: Annotated[int, Field(ge=1)] = 1
+    sweep: TomlTable | None = None
 
 
 class _ModalStep(BaseModel):
@@ -138,6 +142,8 @@ class _ModalStep(BaseModel):
     add: list[Name] = []
     modes: Annotated[int, Field(ge=1)] = 10
     mass_model: MassModelName = "auto"
+    damping: TomlTable | None = None
+    sweep: TomlTable | None = None
 
 
 class _TransientStep(BaseModel):
@@ -158,6 +164,7 @@ class _TransientStep(BaseModel):
     mass_model: MassModelName = "auto"
     inertia: Literal["lagrangian", "paper"] = "lagrangian"
     jump_reference: Name | None = None  # an earlier static step: jump_height results
+    sweep: TomlTable | None = None
 
 
 class _Form(BaseModel):

@@ -16,6 +16,7 @@ import scipy.sparse as sp
 from catdae.case import Case
 from catdae.case.timefunc import TimeFunction
 from catdae.element.elements import Elements, ElementState, PointLoads
+from catdae.model.connectors import build_connectors, extend, with_connectors
 from catdae.model.fluid import Fluid
 from catdae.model.loading import (  # noqa: F401  (re-exported)
     Loading,
@@ -57,9 +58,9 @@ class Pattern:
                  scale: float = 1.0) -> np.ndarray:
         """CSR data array (nnz,) of scale * Σ blocks + diag."""
         data = np.zeros(self.nnz + 1)
-        if blocks is not None:
-            data += np.bincount(self._emap_full, weights=blocks.reshape(-1),
-                                minlength=self.nnz + 1)
+        if blocks is not None:  # element blocks alone leave the connectors' out
+            emap = self._emap_full[:blocks.size]
+            data += np.bincount(emap, weights=blocks.reshape(-1), minlength=self.nnz + 1)
         if diag is not None:
             data[:-1][self._dmap] += diag
         return scale * data[:-1] if scale != 1.0 else data[:-1]
@@ -84,6 +85,10 @@ class Model(MassMatrices):
         ends = (free_hanging_ends(case, mesh, self.loading.node_mass) if mass_model == "auto"
                 else [])
         self.mass_model = choose_mass_model(mass_model, kind, ends)
+        # springs, dampers, bars (None when the scene has none); bar weights and lumped
+        # masses go into the loading
+        self.connectors = build_connectors(case, mesh, self.loading,
+                                           self.mass_model.lumped_fraction)
         nn = mesh.n_nodes
         self.n_dof = 3 * nn
         fixed = np.zeros((nn, 3), bool)
@@ -113,7 +118,7 @@ class Model(MassMatrices):
                                             ld.internal_force.copy()))
         self._t_internal: float | None = None if ld.internal_timed else 0.0
         self.edofs = (3 * mesh.conn[:, :, None] + np.arange(3)).reshape(-1, 6)  # (n_elem, 6)
-        self.pattern = Pattern(self.edofs, self.n_dof)
+        self.pattern = Pattern(with_connectors(self.edofs, self.connectors), self.n_dof)
         self.gauss_s, self.gauss_w = mesh.gauss()
         self.total_mass = float((mesh.m * mesh.L0).sum() + ld.node_mass.sum()
                                 + ld.mass_value.sum())
@@ -189,11 +194,14 @@ class Model(MassMatrices):
     def element_state(self, X: np.ndarray, h0: np.ndarray | None = None) -> ElementState:
         return self.elements.solve(self.chords(X), h0)
 
-    def internal_force(self, state: ElementState) -> np.ndarray:
-        """Σ_e r_e: forces the nodes supply to hold the elements, (n_dof,) N (docs/theory.md §4)."""
+    def internal_force(self, state: ElementState, X: np.ndarray | None = None) -> np.ndarray:
+        """Σ_e r_e: forces the nodes supply to hold the elements (and, given the positions X,
+        the connectors), (n_dof,) N (docs/theory.md §4, §15)."""
         r = self.elements.end_forces(state.h)  # (n_elem, 2, 3)
-        return np.bincount(self.edofs.ravel(), weights=r.reshape(-1),
-                           minlength=self.n_dof)
+        f = np.bincount(self.edofs.ravel(), weights=r.reshape(-1), minlength=self.n_dof)
+        if X is not None and self.connectors is not None:
+            f = f + self.connectors.force(X)  # (bincount of no element gives ints)
+        return f
 
     def element_lambda2(self, state: ElementState, X: np.ndarray) -> np.ndarray:
         """Irvine's λ² of each element from its stiffness along the chord, (n_elem,).
@@ -211,12 +219,16 @@ class Model(MassMatrices):
                              np.inf)
         return np.maximum(12.0 * (ratio - 1.0), 0.0)
 
-    def stiffness_data(self, state: ElementState) -> np.ndarray:
-        """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``)."""
-        return self.pattern.assemble(state.stiffness6)
+    def stiffness_data(self, state: ElementState, X: np.ndarray | None = None) -> np.ndarray:
+        """CSR data of the tangent stiffness K_t on the full dof set (pattern ``self.pattern``);
+        with the connectors' given the positions X."""
+        k6 = state.stiffness6
+        if X is not None and self.connectors is not None:
+            k6 = extend(k6, self.connectors.stiffness_blocks(X), self.mesh.n_elements)
+        return self.pattern.assemble(k6)
 
-    def stiffness(self, state: ElementState) -> sp.csr_matrix:
-        return self.pattern.matrix(self.stiffness_data(state))
+    def stiffness(self, state: ElementState, X: np.ndarray | None = None) -> sp.csr_matrix:
+        return self.pattern.matrix(self.stiffness_data(state, X))
 
     # ------------------------------------------------------------------------- reporting
     def reactions(self, state: ElementState, t: float, X: np.ndarray | None = None
@@ -226,7 +238,7 @@ class Model(MassMatrices):
         Node equilibrium: support force + external load = Σ resisting forces. Inertia of point
         masses sitting on a support node is not included (the support carries it directly).
         """
-        r = self.internal_force(state) - self.nodal_load(t)
+        r = self.internal_force(state, X) - self.nodal_load(t)
         if self.fluid is not None and X is not None:  # the fluid on the support nodes
             r += self.fluid.static(X)[0]
         out = np.full(self.n_dof, np.nan)

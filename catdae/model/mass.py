@@ -9,6 +9,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from catdae.element.elements import ElementState
+from catdae.model.connectors import extend
 
 
 class MassMatrices:
@@ -123,7 +124,10 @@ class MassMatrices:
         """CSR data of the mass matrix M(q) on the full dof set."""
         if self.mass_model.lumped:
             return self.pattern.assemble(None, self.lumped_mass_diag())
-        return self.pattern.assemble(self.element_mass(state), self.diagonal_mass())
+        me = self.element_mass(state)
+        if self.connectors is not None:  # the bars' consistent-mass correction (theory §15)
+            me = extend(me, self.connectors.mass_blocks(), self.mesh.n_elements)
+        return self.pattern.assemble(me, self.diagonal_mass())
 
     def mass(self, state: ElementState) -> sp.csr_matrix:
         return self.pattern.matrix(self.mass_data(state))

@@ -146,7 +146,7 @@ class Mesh:
 
         Elements with fewer points than the largest count are padded with zero weights.
         """
-        gmax = int(self.gauss_points.max())
+        gmax = int(self.gauss_points.max(initial=1))  # 1: a scene of connectors alone
         s = np.zeros((self.n_elements, gmax))
         wts = np.zeros((self.n_elements, gmax))
         for g in np.unique(self.gauss_points):

@@ -48,8 +48,8 @@ def _coords(mesh: Mesh, with_elements: bool = True) -> dict:
     """Labels and arc lengths. Nodes are stored cable by cable, each from its first end to its
     last (a node shared by cables with the first that reaches it; mesh.build_mesh)."""
     on_cable = mesh.cable_of_node >= 0
-    node_cable = np.where(on_cable, np.array(mesh.cable_names, dtype=object)[
-        np.maximum(mesh.cable_of_node, 0)], "")
+    names = np.array((*mesh.cable_names, ""), dtype=object)  # "": no cable at all
+    node_cable = np.where(on_cable, names[np.maximum(mesh.cable_of_node, 0)], "")
     coords = {
         "node": _label("node", mesh.node_names, "node name"),
         "axis": _label("axis", AXES, "global axis (z up)"),

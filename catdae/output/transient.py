@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from catdae._xr import xr
 from catdae.output import results
+from catdae.output.connectors import with_connector_forces
 from catdae.output.fluid import with_fluid
 
 
@@ -22,6 +23,7 @@ def dataset(rec) -> xr.Dataset:
     if rec.work is not None:
         ds["energy_fluid_work"] = xr.Variable("time", rec.W[sl], {
             "units": "J", "long_name": "work done on the cables by the water and the air"})
+    ds = with_connector_forces(ds, rec.prob.model.connectors, rec.X[sl], rec.V[sl])
     fl = rec.prob.model.fluid  # water and air: surface elevation, fluid velocity
     return ds if fl is None else with_fluid(ds, fl, rec.times[sl], rec.X[sl])
 

@@ -33,7 +33,7 @@ class ModalSolution:
 def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) -> ModalSolution:
     """The n_modes lowest modes of the model linearised about positions X and element state."""
     free = model.free
-    k = model.stiffness(state)[free][:, free]
+    k = model.stiffness(state, X)[free][:, free]
     m = model.mass(state)
     if model.fluid is not None:  # the added mass of the water (docs/theory.md §13)
         m = m + model.pattern.matrix(model.pattern.assemble(model.fluid.mass(X)))

@@ -182,7 +182,7 @@ def _extreme_frequency(prob: TransientProblem, t0: float, y0: np.ndarray,
     n = prob.n
     try:
         mff = prob.ff(prob.mass_data(conf))
-        kff = prob.ff(prob.model.pattern.assemble(conf[0].stiffness6))
+        kff = prob.ff(prob.blocks(conf, 0.0)[0])  # K_t, with connectors if any
         if n <= 400:
             k = n - 1 if highest else 0
             lam = sla.eigh(kff.toarray(), mff.toarray(), eigvals_only=True,

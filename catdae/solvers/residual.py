@@ -47,6 +47,7 @@ from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.model.settings import DampingModel
+from catdae.solvers.connector_terms import ConnectorTerms
 from catdae.solvers.layout import UnknownLayout
 from catdae.solvers.record import potential
 from catdae.solvers.start import ConsistentStart
@@ -60,7 +61,7 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return v
 
 
-class TransientProblem(ConsistentStart):
+class TransientProblem(ConsistentStart, ConnectorTerms):
     """Residual and iteration matrix of one transient step, with evaluation counters."""
 
     def __init__(self, model: Model, step, X0: np.ndarray, h0: np.ndarray | None):
@@ -166,6 +167,8 @@ class TransientProblem(ConsistentStart):
         if not ok:
             self._buffers_at = None
             return False
+        if self.connectors is not None:  # springs, dampers, bars (docs/theory.md §15)
+            self._add_connector_force(res)
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = (t, np.array(y[0::2], copy=True))
@@ -197,6 +200,8 @@ class TransientProblem(ConsistentStart):
         The last evaluation is cached: IDA calls the iteration matrix at the state of the
         residual it has just evaluated.
         """
+        if self.connectors is not None:
+            self._place(t, q)
         if self._cache_t == t and np.array_equal(self._cache_q, q):
             return self._cache
         at = self._buffers_at
@@ -245,6 +250,8 @@ class TransientProblem(ConsistentStart):
         out += self.m_diag * A - m.nodal_load(t)
         if damped:
             out += (self.c_diag + self.alpha * self.m_diag) * V
+        if self.connectors is not None:
+            out += self.connectors.force(self.X, V, A, self.alpha)
         if m.fluid is not None:
             out += m.fluid.evaluate(t, self._conf_X(), V, A)[0]
         return out
@@ -278,16 +285,19 @@ class TransientProblem(ConsistentStart):
             vv += np.einsum("eki,kj->eij", qv, _S) - np.einsum("ki,ekj->eij", _S, qv)
             k6 = k6 + np.einsum("eki,kj->eij", qa, _S)
         diag = (cj + self.alpha) * self.m_diag + self.c_diag
+        if self.connectors is not None:
+            k6, vv = self._connector_blocks(k6, vv, V, cj)
         return m.pattern.assemble(k6), m.pattern.assemble(vv, diag)
 
     def mass_data(self, conf) -> np.ndarray:
         """CSR data (full dofs) of M(q) (with the added mass of the water, if any)."""
         m = self.model
+        me = conf[1] if self.connectors is None else self._with_bar_mass(conf[1])
         if m.fluid is not None:
             z = np.zeros(self.n_dof)
             ma = m.fluid.evaluate(self._cache_t, self._conf_X(), z, z)[1]
-            return m.pattern.assemble(conf[1], self.m_diag) + m.pattern.assemble(ma)
-        return m.pattern.assemble(conf[1], self.m_diag)
+            return m.pattern.assemble(me, self.m_diag) + m.pattern.assemble(ma)
+        return m.pattern.assemble(me, self.m_diag)
 
     def _conf_X(self) -> np.ndarray:
         """Node positions (n_dof,) of the configuration last returned by ``configuration``."""
@@ -316,7 +326,7 @@ class TransientProblem(ConsistentStart):
         if conf is None:
             return None
         V = A = None
-        if conf[3] is not None:
+        if conf[3] is not None or self.connectors is not None:
             V, A = self.full_vectors(t, y[1::2], yp[1::2])
         kdata, vdata = self.blocks(conf, cj, V, A)
         fl = self.model.fluid
@@ -382,6 +392,8 @@ class TransientProblem(ConsistentStart):
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        if self.connectors is not None:
+            kinetic, strain = self._connector_energies(X, V, kinetic, strain)
         return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
                 (kinetic, strain, gravity))
 

@@ -31,7 +31,7 @@ class StaticSolution:
 
 
 def _residual(model: Model, state: ElementState, p: np.ndarray, X: np.ndarray) -> np.ndarray:
-    r = model.internal_force(state) - p
+    r = model.internal_force(state, X) - p
     if model.fluid is not None:  # buoyancy, steady current and wind drag (theory §13)
         r += model.fluid.static(X)[0]
     return r[model.free]
@@ -39,8 +39,8 @@ def _residual(model: Model, state: ElementState, p: np.ndarray, X: np.ndarray) -
 
 def _stiffness(model: Model, state: ElementState, X: np.ndarray):
     if model.fluid is None:
-        return model.stiffness(state)
-    return model.pattern.matrix(model.stiffness_data(state)
+        return model.stiffness(state, X)
+    return model.pattern.matrix(model.stiffness_data(state, X)
                                 + model.pattern.assemble(model.fluid.static(X)[1]))
 
 

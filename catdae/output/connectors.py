@@ -1,0 +1,68 @@
+"""Result variables of the connectors and of damped modes (docs/case-format.md, Results).
+
+Added to a step's dataset only when the scene has connectors (``connector_force``) or damping
+(the damped modes of a modal step); a scene without them gets exactly the dataset it had.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catdae._xr import xr
+from catdae.output.results import _label, _var
+
+
+def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
+                          V: np.ndarray | None = None) -> xr.Dataset:
+    """``connector_force`` (N, tension positive) from positions X (..., n_nodes, 3) and
+    velocities V (same shape, or None: at rest); a leading ``time`` axis when X has one."""
+    if connectors is None:
+        return ds
+    X = np.asarray(X)
+    lead = X.shape[:-2]
+    flat_x = X.reshape(-1, *X.shape[-2:])
+    flat_v = None if V is None else np.asarray(V).reshape(flat_x.shape)
+    N = np.array([connectors.axial_force(flat_x[k], None if flat_v is None else flat_v[k])
+                  for k in range(flat_x.shape[0])]).reshape(*lead, connectors.n)
+    dims = ("time", "connector") if lead else ("connector",)
+    return ds.assign(
+        connector_force=_var(dims, N, "N", "axial force of the connector (tension positive): "
+                             "k (d - L) + c dd/dt"),
+    ).assign_coords(
+        connector=_label("connector", connectors.names, "connector name"),
+        connector_kind=_label("connector", connectors.kinds, "spring, damper or bar"),
+    )
+
+
+def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
+                      ) -> xr.Dataset:
+    """The damped modes of a modal step beside its undamped results: ``frequency`` becomes the
+    damped frequency, the undamped one is kept as ``undamped_frequency``; ``damping_ratio``,
+    ``eigenvalue_real``/``eigenvalue_imag`` and ``complex_shape`` per mode (NaN for modes
+    beyond those found underdamped)."""
+    n = ds.sizes["mode"]
+    k = min(n, modes.s.size)
+
+    def pad(values, fill=np.nan):
+        out = np.full((n, *np.shape(values)[1:]), fill, dtype=np.result_type(values, float))
+        out[:k] = values[:k]
+        return out
+
+    shape = pad(np.stack([shapes.real, shapes.imag], axis=1))  # (n, 2, n_nodes, 3)
+    labels = ["overdamped or not found"] * n
+    return ds.assign(
+        undamped_frequency=ds["frequency"].assign_attrs(
+            long_name="natural frequency of the undamped system"),
+        frequency=_var("mode", pad(modes.frequency), "Hz",
+                       "damped natural frequency Im(s)/2π"),
+        damping_ratio=_var("mode", pad(modes.damping_ratio), "1",
+                           "modal damping ratio -Re(s)/|s|"),
+        eigenvalue_real=_var("mode", pad(modes.s.real), "1/s", "Re(s) of the damped mode"),
+        eigenvalue_imag=_var("mode", pad(modes.s.imag), "rad/s", "Im(s) of the damped mode"),
+        complex_shape=_var(("mode", "part", "node", "axis"), shape, "1",
+                           "complex shape of the damped mode (largest component = 1)"),
+        damped_plane=_label("mode", list(plane[:k]) + labels[k:],
+                            "plane of the damped mode (from the real part of its shape)"),
+        damped_symmetry=_label("mode", list(symmetry[:k]) + labels[k:],
+                               "symmetry of the damped mode (from the real part of its shape)"),
+    ).assign_coords(part=_label("part", ["real", "imag"], "part of the complex shape"))

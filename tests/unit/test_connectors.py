@@ -1,0 +1,207 @@
+"""Connectors (``catdae.model.connectors``, issue 22): their forces against finite differences
+of themselves and of their energy, the transient iteration matrix of a scene with springs,
+dampers and bars against finite differences of its residual, and bad input refused with a
+located message and exit 2."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from catdae.case import case_from_dict
+from catdae.model.connectors import Connectors
+
+from scene_toml import cable_scene, static_step, transient_step
+
+
+def _toml(text):
+    import tomllib
+
+    return case_from_dict(tomllib.loads(text))
+
+
+def some_connectors() -> Connectors:
+    """A spring, a damper and a bar with mass among 4 nodes (ρ: the consistent correction)."""
+    return Connectors(("s", "d", "b"), ("spring", "damper", "bar"),
+                      np.array([[0, 1], [2, 1], [3, 0]]), np.array([3e3, 0.0, 2e5]),
+                      np.array([1.3, 0.0, 2.0]), np.array([0.0, 50.0, 0.0]),
+                      np.array([0.0, 0.0, 4.0]))
+
+
+def assembled(cn: Connectors, blocks: np.ndarray, n_dof: int) -> np.ndarray:
+    out = np.zeros((n_dof, n_dof))
+    for e in range(cn.n):
+        out[np.ix_(cn.edofs[e], cn.edofs[e])] += blocks[e]
+    return out
+
+
+def test_connector_blocks_are_the_derivatives_of_their_forces():
+    """∂f/∂x (with the damper's geometric term at a nonzero velocity), ∂f/∂v and ∂f/∂a against
+    central differences; the elastic forces are the gradient of the strain energy."""
+    rng = np.random.default_rng(1)
+    cn = some_connectors()
+    X, V, A = (rng.normal(size=(4, 3)) for _ in range(3))
+    h = 1e-6
+
+    def fd(which, h=h):
+        out = np.zeros((12, 12))
+        for j in range(12):
+            d = np.zeros(12)
+            d[j] = h
+            args = [X.ravel(), V.ravel(), A.ravel()]
+            plus = list(args)
+            minus = list(args)
+            plus[which] = args[which] + d
+            minus[which] = args[which] - d
+            out[:, j] = (cn.force(*(a.reshape(-1, 3) for a in plus))
+                         - cn.force(*(a.reshape(-1, 3) for a in minus))) / (2 * h)
+        return out
+
+    K = assembled(cn, cn.stiffness_blocks(X, V), 12)
+    C = assembled(cn, cn.damping_blocks(X), 12)
+    M = assembled(cn, cn.mass_blocks(), 12)
+    assert np.abs(K - fd(0)).max() <= 1e-8 * np.abs(K).max()
+    assert np.abs(C - fd(1)).max() <= 1e-8 * np.abs(C).max()
+    # linear in the accelerations: a unit step is exact (forces ~1e5 N would drown a small one)
+    assert np.abs(M - fd(2, 1.0)).max() <= 1e-9 * np.abs(M).max()
+    grad = np.array([(cn.strain_energy(X + h * e.reshape(4, 3))
+                      - cn.strain_energy(X - h * e.reshape(4, 3))) / (2 * h)
+                     for e in np.eye(12)])
+    assert np.abs(grad - cn.force(X)).max() <= 1e-8 * np.abs(grad).max()
+    # a rigid rotation leaves the axial forces unchanged (large rotations exact)
+    c, s = np.cos(0.7), np.sin(0.7)
+    R = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    assert np.allclose(cn.axial_force(X @ R.T, V @ R.T), cn.axial_force(X, V), rtol=1e-13)
+
+
+NETWORK = """[[springs]]
+name = "k1"
+ends = ["c.1", "G"]
+stiffness = 3.0e3
+length = 2.5
+[[dampers]]
+name = "d1"
+ends = ["c.2", "G"]
+coefficient = 400.0
+[[bars]]
+name = "hanger"
+ends = ["c.3", "H"]
+EA = 1.0e6
+mass = 3.0
+[[point_masses]]
+name = "pm"
+node = "H"
+mass = 5.0
+"""
+
+
+def network(mass_model: str) -> str:
+    """A cable with a spring and a damper to the ground G and a bar hanging a mass H."""
+    step = transient_step("dyn", 0.1, 0.05, rtol=1e-6, atol=1e-8)
+    return cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
+                       extra=NETWORK, steps=step + f'mass_model = "{mass_model}"\n').replace(
+        "[supports]\n", '[supports]\nG = "pinned"\n').replace(
+        "[nodes]\n", "[nodes]\nG = [5.0, 2.0, -1.0]\nH = [7.5, 0.5, -4.0]\n")
+
+
+@pytest.mark.parametrize("mass_model", ["lumped", "linear"])
+def test_transient_iteration_matrix_is_the_derivative_of_the_residual(mass_model):
+    """With a constant element mass (lumped, linear) the analytic iteration matrix
+    J = ∂r/∂y + c_j ∂r/∂y' is exact, connectors included (the linear model gives the bar its
+    consistent mass): it equals central differences of the residual at a moving state."""
+    from catdae.model.assembly import Model
+    from catdae.model.mesh import build_mesh
+    from catdae.solvers.residual import TransientProblem
+
+    case = _toml(network(mass_model))
+    mesh = build_mesh(case)
+    model = Model(case, mesh, set(), mass_model=mass_model, kind="transient")
+    assert model.connectors is not None and model.connectors.n == 3
+    prob = TransientProblem(model, case.steps[0], mesh.X0, None)
+    rng = np.random.default_rng(3)
+    n = prob.n
+    y = np.empty(2 * n)
+    yp = np.empty(2 * n)
+    y[0::2] = mesh.X0.reshape(-1)[prob.fidx] + 0.05 * rng.normal(size=n)
+    y[1::2] = rng.normal(size=n)
+    yp[:] = rng.normal(size=2 * n)
+    cj = 37.0
+    J = np.zeros((2 * n, 2 * n))
+
+    def residual(yy, yyp):
+        r = np.empty(2 * n)
+        assert prob.evaluate(0.0, yy, yyp, r)
+        return r
+
+    residual(y, yp)
+    prob.jac_dense(0.0, y, yp, None, cj, J)
+    h = 1e-6
+    fd = np.zeros_like(J)
+    for j in range(2 * n):
+        d = np.zeros(2 * n)
+        d[j] = h
+        fd[:, j] = (residual(y + d, yp + cj * d) - residual(y - d, yp - cj * d)) / (2 * h)
+    # the spring alone (3e3 N/m) is 7 % of the largest entry: a missing block would show
+    assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max()
+
+
+def test_connectors_off_leave_the_model_as_it_was():
+    """A scene without connectors: no connector object, the pattern of the elements alone."""
+    from catdae.model.assembly import Model
+    from catdae.model.mesh import build_mesh
+
+    case = _toml(cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
+                             steps=static_step("st")))
+    model = Model(case, build_mesh(case), set())
+    assert model.connectors is None
+    assert model.pattern.nnz == 3 * 3 * (3 * 5 - 2) + 0  # 5 nodes in a chain: 13 3x3 blocks
+
+
+# ------------------------------------------------------------------------------------------------
+# bad input: a located message and exit 2
+# ------------------------------------------------------------------------------------------------
+def bad(extra: str) -> str:
+    """The network's cable with a ground node G, a second ground G2 at the same place."""
+    return cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
+                       extra=extra, steps=static_step("st")).replace(
+        "[supports]\n", '[supports]\nG = "pinned"\nG2 = "pinned"\n').replace(
+        "[nodes]\n", "[nodes]\nG = [5.0, 2.0, -1.0]\nG2 = [5.0, 2.0, -1.0]\n")
+
+
+@pytest.mark.parametrize(("extra", "field", "words"), [
+    ('[[springs]]\nname = "k"\nends = ["c.2", "nowhere"]\nstiffness = 1.0\n',
+     "springs[0].ends[1]", "unknown node 'nowhere'"),
+    ('[[springs]]\nname = "k"\nends = ["c.2", "c.9"]\nstiffness = 1.0\n',
+     "springs[0].ends[1]", "mesh node 'c.9' does not exist"),
+    ('[[dampers]]\nname = "d"\nends = ["c.2", "G"]\ncoefficient = -5.0\n',
+     "dampers[0].coefficient", "expected a value >= 0.0, found the number -5.0"),
+    ('[[bars]]\nname = "b"\nends = ["c.2", "G"]\nEA = 1.0e6\nlength = 0.0\n',
+     "bars[0].length", "expected a value > 0.0, found the number 0.0"),
+    ('[[bars]]\nname = "b"\nends = ["G", "G2"]\nEA = 1.0e6\n',
+     "bars[0].ends", "a bar of zero length: nodes 'G' and 'G2' coincide"),
+    ('[[dampers]]\nname = "d"\nends = ["c.1", "c.1"]\ncoefficient = 5.0\n',
+     "dampers[0].ends", "the two ends are the same node 'c.1'"),
+])
+def test_bad_connectors_get_a_located_message_and_exit_2(extra, field, words, tmp_path, capsys):
+    from catdae.cli import main
+
+    f = tmp_path / "bad.toml"
+    f.write_text(bad(extra))
+    for args in (["check", str(f)], ["run", str(f), "-o", str(tmp_path / "o.nc")]):
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert f"{f}: {field}: {words}" in err, err
+    assert not (tmp_path / "o.nc").exists()
+
+
+def test_more_elements_keep_a_connector_on_its_mesh_node(tmp_path):
+    """``elements`` overrides move an end on mesh node c.k to the same place of the new mesh,
+    and refuse a count that puts it between mesh nodes."""
+    from catdae.errors import CaseError
+
+    case = _toml(network("lumped"))
+    finer = case.with_overrides(elements=8)
+    assert [d.ends for d in finer.dampers] == [("c.4", "G")]
+    assert [b.ends for b in finer.bars] == [("c.6", "H")]
+    with pytest.raises(CaseError, match="use a multiple of 4 elements"):
+        case.with_overrides(elements=6)
