@@ -208,7 +208,14 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
         return _modal_step(step, model, state)
     from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 
-    return as_dataset(run_transient(step, model, state, writer, progress))
+    ds = as_dataset(run_transient(step, model, state, writer, progress))
+    if model.case.seabed is not None:  # touchdown and length on the seabed over time (§17)
+        from catdae.model.seabed import SeabedContact
+        from catdae.output.seabed import add_seabed_history
+
+        ds = add_seabed_history(ds, model.mesh, model.case.seabed.z,
+                                SeabedContact.of_step(model))
+    return ds
 
 
 def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _State):
@@ -228,6 +235,13 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
 
 
 def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
+    if model.case.seabed is not None:  # docs/theory.md §17
+        from catdae.output.seabed import add_seabed
+        from catdae.solvers.seabed_static import solve_static_on_seabed
+
+        sol, model, summary = solve_static_on_seabed(model, state.X, state.h, t=state.t,
+                                                     load_steps=step.load_steps)
+        return add_seabed(_static_result(model, state, sol), model.mesh, summary)
     sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
     return _static_result(model, state, sol)
 
@@ -266,6 +280,10 @@ def engineering_results(step: Step, ds: xr.Dataset, case: Case,
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     model.set_time(state.t)
+    if model.case.seabed is not None:  # the seabed's contact springs (docs/theory.md §17)
+        from catdae.model.seabed import ContactModel
+
+        model = ContactModel.of(model)
     est = model.element_state(state.X, state.h)
     if (est.status == NOT_CONVERGED).any():
         raise ConvergenceError(f"modal step '{step.name}': an element cannot be solved in the "

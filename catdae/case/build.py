@@ -19,6 +19,7 @@ from pydantic import BaseModel, ValidationError
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
 from catdae.case.build_connectors import _ConnectorsPass, connector_ends
 from catdae.case.build_fluid import _FluidPass
+from catdae.case.build_seabed import _SeabedPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.fluid import line_fluid
@@ -59,7 +60,7 @@ def _bounded(message: str) -> str:
 
 
 class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, _FluidPass,
-               _GroundPass):
+               _GroundPass, _SeabedPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -136,6 +137,9 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
         self.fluid_lines(top.materials, water, air)
+        seabed = self.seabed(top.seabed, nodes, supports, materials, steps,
+                             water_floor=None if water is None or not math.isfinite(water.depth)
+                             else water.surface - water.depth)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -148,8 +152,9 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            **connectors, steps=tuple(steps), water=water, air=air, path=self.path, text=text,
-            name=name, reference_temperature=top.reference_temperature, ground=ground,
+            **connectors, steps=tuple(steps), water=water, air=air, seabed=seabed,
+            path=self.path, text=text, name=name,
+            reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:

@@ -20,7 +20,7 @@ from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
                   "element/mass_gradient", "element/residual_kernel", "element/fluid_kernel",
-                  "element/fluid_kinematics")
+                  "element/fluid_kinematics", "element/grounded")
 _STAMP = "catdae-kernels.sha256"
 
 

@@ -46,6 +46,7 @@ from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.seabed import SeabedContact
 from catdae.model.settings import DampingModel
 from catdae.solvers.connector_terms import ConnectorTerms
 from catdae.solvers.layout import UnknownLayout
@@ -103,6 +104,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
         self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
         self._fast_setup()
+        # the seabed's penalty contact (docs/theory.md §17); None for a scene without one
+        self.seabed = SeabedContact.of_step(model)
 
     def _fast_setup(self) -> None:
         """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
@@ -174,6 +177,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
         self._buffers_at = (t, np.array(y[0::2], copy=True))
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
+        if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §17)
+            res[1::2] -= self.seabed.forces(self._Xb.reshape(-1, 3),
+                                            self._Vb.reshape(-1, 3)).ravel()[self._fidx]
         return True
 
     def _conf_from_buffers(self):
@@ -254,6 +260,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
             out += self.connectors.force(self.X, V, A, self.alpha)
         if m.fluid is not None:
             out += m.fluid.evaluate(t, self._conf_X(), V, A)[0]
+        if self.seabed is not None:
+            out -= self.seabed.forces(self._conf_X().reshape(-1, 3), V.reshape(-1, 3)).ravel()
         return out
 
     def blocks(self, conf, cj, V=None, A=None):
@@ -336,6 +344,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
             pat = self.model.pattern
             kdata = kdata + pat.assemble(kx)
             vdata = vdata + pat.assemble(cj * ma + kv)
+        if self.seabed is not None:  # docs/theory.md §17: -∂f/∂q, -∂f/∂v of the contact
+            V, _ = self.full_vectors(t, y[1::2], yp[1::2])
+            kdata, vdata = self.seabed.add_derivatives(kdata, vdata, self._conf_X(), V)
         sel = self.ff_sel
         return kdata[sel], vdata[sel]
 
@@ -392,6 +403,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        if self.seabed is not None:  # the contact springs' energy (docs/theory.md §17)
+            gravity += self.seabed.energy(X.reshape(-1, 3))
         if self.connectors is not None:
             kinetic, strain = self._connector_energies(X, V, kinetic, strain)
         return (X, V, A, m.elements.end_tensions(h), reaction.reshape(-1, 3),
