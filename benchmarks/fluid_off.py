@@ -53,7 +53,8 @@ def main() -> None:
     a = ap.parse_args()
     rows = []
     for r in range(a.repeats):
-        for label, tree in (("base", Path(a.base)), ("fluid", HERE)):
+        pair = (("base", Path(a.base)), ("fluid", HERE))
+        for label, tree in (pair if r % 2 == 0 else pair[::-1]):  # alternate who goes first
             out = run(tree, a.case)
             rows.append((label, r, out))
             print(f"{label:6s} run {r}: cpu {out['cpu']:.3f} s, wall {out['wall']:.3f} s, "

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import copy
 import os
+import traceback
 from collections.abc import Callable
 from pathlib import Path
 
@@ -20,7 +21,7 @@ from catdae.case.frame import rotate_back, to_gravity_frame
 from catdae.case.sweep import apply_sweep
 from catdae.case.sweep import units as sweep_units
 from catdae.element.elements import NOT_CONVERGED
-from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutputError
+from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutOfMemory, OutputError
 from catdae.interrupts import deferred
 from catdae.model import formfind
 from catdae.model.assembly import Model
@@ -28,6 +29,7 @@ from catdae.model.mesh import build_mesh
 from catdae.model.span import span_quantities
 from catdae.output import engineering, results
 from catdae.output.connectors import with_connector_forces, with_damped_modes
+from catdae.output.files import check_output, clean_stale, free_name, warm_writer
 from catdae.output.transient import as_dataset
 from catdae.solvers.damped_modes import solve_damped
 from catdae.solvers.modal import classify, solve_modal
@@ -104,6 +106,14 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 status += f": {ds_partial.attrs.get('status')}"
             writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
+        except MemoryError as exc:  # a step failure like any other: what was computed is kept
+            if exc.__traceback__ is not None:  # free the failed step's arrays before writing
+                traceback.clear_frames(exc.__traceback__)
+            del exc
+            err = OutOfMemory.in_step(step.name)
+            status = f"failed in step '{step.name}': {err}"
+            writer.keep_failed(err, results.make_tree(case, groups, status=status))
+            raise err from None
         except CatdaeError as exc:
             ds_partial = as_dataset(getattr(exc, "partial", None))
             if isinstance(ds_partial, xr.Dataset):
@@ -198,7 +208,14 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.D
         return _modal_step(step, model, state)
     from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 
-    return as_dataset(run_transient(step, model, state, writer, progress))
+    ds = as_dataset(run_transient(step, model, state, writer, progress))
+    if model.case.seabed is not None:  # touchdown and length on the seabed over time (§17)
+        from catdae.model.seabed import SeabedContact
+        from catdae.output.seabed import add_seabed_history
+
+        ds = add_seabed_history(ds, model.mesh, model.case.seabed.z,
+                                SeabedContact.of_step(model))
+    return ds
 
 
 def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _State):
@@ -218,6 +235,13 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
 
 
 def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
+    if model.case.seabed is not None:  # docs/theory.md §17
+        from catdae.output.seabed import add_seabed
+        from catdae.solvers.seabed_static import solve_static_on_seabed
+
+        sol, model, summary = solve_static_on_seabed(model, state.X, state.h, t=state.t,
+                                                     load_steps=step.load_steps)
+        return add_seabed(_static_result(model, state, sol), model.mesh, summary)
     sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
     return _static_result(model, state, sol)
 
@@ -256,6 +280,10 @@ def engineering_results(step: Step, ds: xr.Dataset, case: Case,
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     model.set_time(state.t)
+    if model.case.seabed is not None:  # the seabed's contact springs (docs/theory.md §17)
+        from catdae.model.seabed import ContactModel
+
+        model = ContactModel.of(model)
     est = model.element_state(state.X, state.h)
     if (est.status == NOT_CONVERGED).any():
         raise ConvergenceError(f"modal step '{step.name}': an element cannot be solved in the "
@@ -275,37 +303,15 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     return ds
 
 
-def check_output(output: str | os.PathLike, case: Case | None = None) -> Path:
-    """The output path, judged before any work: a regular file (or none yet) in a directory
-    catdae may write in, and not the case file itself. Raises OutputError saying why not."""
-    out = Path(output)
-
-    def refuse(why: str):
-        raise OutputError(f"cannot write the results to {out}: {why}")
-
-    if str(output) == "" or out.is_dir():
-        refuse("it is a directory (give a file name, e.g. -o results.nc)")
-    if out.exists() and not out.is_file():
-        refuse("it exists and is not a regular file")
-    parent = out.parent
-    if not parent.is_dir():
-        refuse(f"no directory {parent}")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        refuse(f"no permission to create files in {parent}")
-    if out.exists() and not os.access(out, os.W_OK):
-        refuse("it exists and is read-only")
-    src = getattr(case, "path", None)
-    if src is not None and out.exists() and Path(src).exists() and out.samefile(src):
-        refuse("it is the case file")
-    return out
-
-
 class _Writer:
     """The one writer of a run's results (atomically, through results.write_tree).
 
     - ``write_increment``: during long transient steps, a snapshot ``<stem>.partial.nc`` whose
-      unfinished step is marked ``running``; a disk error there is remembered, not fatal.
-    - ``write_final``: the complete tree to the output; the snapshot is then removed.
+      unfinished step is marked ``running``; a disk error there is remembered, not fatal. When a
+      file of that name is already there (another run's live snapshot, or a user's file), the
+      snapshot goes to ``<stem>.partial-2.nc`` (-3, ...): never over a file it did not write.
+    - ``write_final``: the complete tree to the output; the snapshot is then removed (only one
+      that this process wrote).
     - ``keep_failed``: the tree of a failed or interrupted run, to the output, or beside it
       (``<stem>.failed.nc``, ``.failed-2.nc``, ...) when a file is there: never over a file.
     A disk error (a full disk, a lost mount) becomes one OutputError that says what was lost
@@ -319,12 +325,26 @@ class _Writer:
         self.groups = groups
         self.existed = self.output is not None and self.output.exists()
         self.snapshot_error: OSError | None = None
+        self.snapshot_written = False  # the snapshot file is this process's own
+        self._partial: Path | None = None
+        if self.output is not None:
+            clean_stale(self.output.parent, self.output.stem)
+            warm_writer(self.output)  # so that writing after a MemoryError maps no library
 
     @property
     def partial_path(self) -> Path | None:
+        """The snapshot's name, chosen at the first snapshot: the first of ``<stem>.partial.nc``,
+        ``<stem>.partial-2.nc``, ... that is not already there."""
         if self.output is None:
             return None
-        return self.output.with_name(self.output.stem + ".partial.nc")
+        if self._partial is None:
+            self._partial = free_name(self.output, ".partial")
+        return self._partial
+
+    def _remove_snapshot(self) -> None:
+        if self.snapshot_written:
+            self.partial_path.unlink(missing_ok=True)
+            self.snapshot_written = False
 
     def _write(self, tree: xr.DataTree, path: Path) -> None:
         with deferred():
@@ -341,14 +361,19 @@ class _Writer:
         tree = results.make_tree(self.case, {**self.groups,
                                              name: rotate_back(ds, self.rotation)},
                                  status=f"running step '{name}' (snapshot, not a result)")
+        target = self.partial_path
+        if not self.snapshot_written and target.exists():
+            return  # a file of that name appeared since: not ours to replace
         try:
-            self._write(tree, self.partial_path)
+            self._write(tree, target)
         except OSError as exc:  # the run goes on; the final write says if it fails too
             self.snapshot_error = exc
+        else:
+            self.snapshot_written = True
 
     def _lost(self, target: Path, exc: OSError, what: str) -> str:
         reason = exc.strerror or str(exc)
-        if self.partial_path.exists():
+        if self.snapshot_written and self.partial_path.exists():
             kept = f"the last snapshot of the run is kept in {self.partial_path}"
         elif self.snapshot_error is not None:
             snap = self.snapshot_error.strerror or str(self.snapshot_error)
@@ -364,7 +389,7 @@ class _Writer:
             self._write(tree, self.output)
         except OSError as exc:
             raise OutputError(self._lost(self.output, exc, "the results")) from None
-        self.partial_path.unlink(missing_ok=True)
+        self._remove_snapshot()
 
     def failed_path(self) -> Path:
         target = self.output
@@ -390,4 +415,4 @@ class _Writer:
             exc.output_error = self._lost(target, err, "the results computed so far")
             return
         exc.output_path = target
-        self.partial_path.unlink(missing_ok=True)
+        self._remove_snapshot()

@@ -2,8 +2,10 @@
 
 Errors become one clear message on stderr and a non-zero exit code:
 1 analysis failed or results cannot be written (what was computed is written if it can be, or
-the loss is stated), 2 invalid case or usage (judged before any work), 130 interrupted by Ctrl-C
-(SIGINT), 143 stopped by SIGTERM; after an interrupt the partial results are written and marked.
+the loss is stated), 2 invalid case, usage or an unreadable results file (judged before any
+work), 130 interrupted by Ctrl-C (SIGINT), 143 stopped by SIGTERM, 129 by SIGHUP; after an
+interrupt the partial results are written and marked. A reader that closes standard output early
+(a broken pipe) stops the printing, never the work.
 """
 
 from __future__ import annotations
@@ -18,8 +20,10 @@ import numpy as np
 
 from catdae._version import __version__
 from catdae.case.schema import MASS_MODEL_NAMES
-from catdae.errors import CaseError, CatdaeError, OutputError
+from catdae.errors import CaseError, CatdaeError, OutputError, ResultsError
 from catdae.interrupts import signals_as_interrupts
+from catdae.output.files import check_folder
+from catdae.progress import say
 
 # catdae.output.plot.WHAT
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
@@ -80,10 +84,11 @@ def main(argv: list[str] | None = None) -> int:
     if argv[:1] == ["study"]:  # its options (and -h) belong to catdae.study
         from catdae.study import main as study_main
 
-        return study_main(argv[1:])
+        with signals_as_interrupts():  # the one signal policy: the study says what it keeps
+            return study_main(argv[1:])
     args = _parser().parse_args(argv)
     try:
-        with signals_as_interrupts():  # SIGTERM stops a run like Ctrl-C: partial results kept
+        with signals_as_interrupts():  # SIGTERM, SIGHUP stop a run like Ctrl-C: partial kept
             if args.command == "check":
                 return _check(args)
             if args.command == "run":
@@ -100,8 +105,14 @@ def main(argv: list[str] | None = None) -> int:
         sep = ": " if len(exc.problems) == 1 else "\n"
         print(f"catdae: invalid case{sep}{exc}", file=sys.stderr)
         return 2
+    except ResultsError as exc:  # an unreadable or foreign results file: bad input
+        print(f"catdae: {exc}", file=sys.stderr)
+        return 2
     except OSError as exc:
         print(f"catdae: cannot write the results: {exc}", file=sys.stderr)
+        return 1
+    except MemoryError:
+        print("catdae: out of memory", file=sys.stderr)
         return 1
     except KeyboardInterrupt as exc:
         code = getattr(exc, "exit_code", 130)
@@ -129,8 +140,8 @@ def _check(args) -> int:
 
     case = load_case(Path(args.case))  # the command line always names a file
     mesh = check_case(case)
-    print(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
-          f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
+    say(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
+        f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
     return 0
 
 
@@ -158,24 +169,26 @@ def _run(args) -> int:
         print(f"catdae: {path}: {exc}", file=sys.stderr)
         _say_where(exc, "before the failure")
         return 1
-    print(summary(tree))
-    print(f"results written to {out}")
+    say(summary(tree))
+    say(f"results written to {out}")
     if args.vtk:
         from catdae.output.export import write_vtk
 
         for p in write_vtk(tree, args.vtk):
-            print(f"ParaView time series written to {p}")
+            say(f"ParaView time series written to {p}")
     return 0
 
 
 def _plot(args) -> int:
     from catdae.output.plot import write_all
-    from catdae.output.results import read_tree
+    from catdae.output.reading import read_results_file
 
-    if not Path(args.results).is_file():
-        print(f"catdae: no results file {args.results}", file=sys.stderr)
+    try:
+        check_folder(args.output, "the figures")
+    except OutputError as exc:  # judged before any work: a usage error
+        print(f"catdae: {exc}", file=sys.stderr)
         return 2
-    tree = read_tree(args.results)
+    tree = read_results_file(args.results)
     try:
         files = write_all(tree, args.output, steps=args.step, what=args.what, node=args.node,
                           times=args.times)
@@ -183,25 +196,35 @@ def _plot(args) -> int:
         print(f"catdae: {args.results}: {exc}", file=sys.stderr)
         return 2
     for f in files:
-        print(f)
+        say(str(f))
+    if not files:
+        print(f"catdae: {args.results}: no figure to make: the steps chosen make none of "
+              f"{', '.join(args.what or WHAT)}", file=sys.stderr)
+        return 2
     return 0
 
 
 def _export(args) -> int:
     from catdae.output.export import write_vtk
-    from catdae.output.results import read_tree
+    from catdae.output.reading import read_results_file
 
-    if not Path(args.results).is_file():
-        print(f"catdae: no results file {args.results}", file=sys.stderr)
+    try:
+        check_folder(args.vtk, "the VTK files")
+    except OutputError as exc:  # judged before any work: a usage error
+        print(f"catdae: {exc}", file=sys.stderr)
         return 2
-    tree = read_tree(args.results)
+    tree = read_results_file(args.results)
     try:
         files = write_vtk(tree, args.vtk, steps=args.step)
     except CatdaeError as exc:
         print(f"catdae: {args.results}: {exc}", file=sys.stderr)
         return 2
     for f in files:
-        print(f"ParaView time series written to {f}")
+        say(f"ParaView time series written to {f}")
+    if not files:
+        print(f"catdae: {args.results}: nothing to export: no static or transient step",
+              file=sys.stderr)
+        return 2
     return 0
 
 

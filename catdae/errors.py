@@ -44,10 +44,27 @@ class OutputError(CatdaeError):
     """The results cannot be written (a directory, no permission, a full disk, ...)."""
 
 
+class OutOfMemory(CatdaeError):
+    """A step needed more memory than the process was given (a MemoryError): the step fails,
+    what the steps before it computed is written, and the status says why."""
+
+    @classmethod
+    def in_step(cls, name: str) -> OutOfMemory:
+        return cls(f"step '{name}' ran out of memory (the machine or a limit such as ulimit -v "
+                   "or a batch scheduler's gave it less than it needs): use fewer elements, "
+                   "fewer outputs or fewer modes")
+
+
+class ResultsError(CatdaeError):
+    """A results file that cannot be read: missing, empty, truncated, corrupted, or not one
+    that catdae wrote (bad input to ``catdae plot`` and ``export``: exit 2)."""
+
+
 class Interrupted(KeyboardInterrupt):
-    """A run stopped by a signal: SIGINT (Ctrl-C) or SIGTERM (``timeout``, batch schedulers,
-    container stops). A ``KeyboardInterrupt``, so that every layer that keeps partial results on
-    Ctrl-C keeps them on SIGTERM too; ``exit_code`` is the shell's 128 + signal number.
+    """A run stopped by a signal: SIGINT (Ctrl-C), SIGTERM (``timeout``, batch schedulers,
+    container stops) or SIGHUP (the terminal closed). A ``KeyboardInterrupt``, so that every
+    layer that keeps partial results on Ctrl-C keeps them on the others too; ``exit_code`` is
+    the shell's 128 + signal number.
 
     Like a ``CatdaeError`` of a failed run, it carries ``partial`` (what was computed) and
     ``output_path`` (where that went) once the pipeline has written it.

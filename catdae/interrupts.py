@@ -1,6 +1,7 @@
-"""SIGINT and SIGTERM as one exception, so that a stopped run keeps and marks what it computed.
+"""SIGINT, SIGTERM and SIGHUP as one exception: a stopped command keeps and marks its work.
 
-``catdae run`` installs :func:`signals_as_interrupts` around the pipeline: either signal raises
+Every command (``catdae run``, ``study``, ``plot``, ``export``) installs
+:func:`signals_as_interrupts` around its work (a closed terminal sends SIGHUP): each signal raises
 :class:`~catdae.errors.Interrupted` (a ``KeyboardInterrupt``) in the main thread, which every step
 turns into partial results with a status saying where it stopped. Once one is raised, further
 signals are ignored until the context ends, so that a second Ctrl-C cannot cut short the writing
@@ -18,7 +19,7 @@ from contextlib import contextmanager
 
 from catdae.errors import Interrupted
 
-SIGNALS = (signal.SIGINT, signal.SIGTERM)
+SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)  # Ctrl-C, kill/timeout, hang-up
 
 
 class _State:
@@ -40,7 +41,7 @@ def _handler(signum, frame):
 
 @contextmanager
 def signals_as_interrupts() -> Iterator[None]:
-    """SIGINT and SIGTERM raise Interrupted inside the block (main thread only; elsewhere a
+    """SIGINT, SIGTERM and SIGHUP raise Interrupted inside the block (main thread only; elsewhere a
     no-op; an ignored signal stays ignored). The previous handlers are restored afterwards."""
     if threading.current_thread() is not threading.main_thread() or _State.installed:
         yield

@@ -183,3 +183,17 @@ def reporter(progress: bool | None, name: str, t0: float, t_end: float):
         return LogProgress(name, t0, t_end, interval=log_interval(),
                            ticker=True)
     return BarProgress(name, t0, t_end) if progress else NoProgress()
+
+
+def say(text: str = "") -> None:
+    """A line on standard output. A reader that has gone (``catdae run | head -1``: a broken
+    pipe) stops the printing, not the work: the rest of the output is discarded."""
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        try:  # further prints and the flush at exit go nowhere instead of failing again
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
+        except (OSError, ValueError):
+            pass

@@ -11,6 +11,7 @@ Contents
 ``irvine_symmetric_roots``      roots of Irvine & Caughey's symmetric in-plane frequency equation.
 ``irvine_caughey_frequencies``  linear free-vibration frequencies of a shallow level cable (Hz).
 ``taut_string_frequencies``     frequencies of a weightless taut string (Hz).
+``grounded_catenary``           elastic catenary from an anchor on a rigid frictionless seabed.
 ``string_with_damper``          exact eigenvalue of a taut string with a viscous damper.
 ``level_catenary_midspan``      midspan of a level elastic catenary with a thermal strain.
 
@@ -44,6 +45,7 @@ __all__ = [
     "irvine_symmetric_roots",
     "irvine_caughey_frequencies",
     "taut_string_frequencies",
+    "grounded_catenary",
     "level_catenary_midspan",
 ]
 
@@ -375,6 +377,51 @@ def piecewise_catenary(span: float, dz: float, EA: float, pieces) -> dict:
         raise RuntimeError(f"piecewise catenary residual {residual:.3e} m too large")
     return {"H": H, "V_i": V, "V_j": V + float((w * L).sum()),
             "position": lambda s: position(s, H, V), "residual": residual}
+
+
+# --------------------------------------------------------------------------------------------------
+# grounded elastic catenary (an anchor on a rigid, frictionless, flat seabed)
+# --------------------------------------------------------------------------------------------------
+def grounded_catenary(span: float, height: float, L0: float, EA: float, w: float) -> dict:
+    """A line from an anchor on the seabed to a fairlead ``span`` away horizontally and
+    ``height`` above it, part of it lying on the seabed (the closed form of MoorPy's and FAST's
+    quasi-static line, with no friction).
+
+    The lying length L_B carries the horizontal tension H alone (stretched by H/EA); the
+    suspended length l_s = L0 - L_B rises as a catenary with zero slope at the touchdown point.
+    Unknowns H and l_s, by two nested ``brentq`` solves: for given H, l_s from the height
+
+        height = (H/w) (sqrt(1 + (w l_s/H)^2) - 1) + w l_s^2/(2 EA),
+
+    then H from the span, span = L_B + (H/w) asinh(w l_s/H) + H L0/EA.
+    Returns H, fairlead vertical force V = w l_s, lying length L_B and the touchdown distance
+    x_td = L_B (1 + H/EA) from the anchor, and the fairlead and anchor tension magnitudes.
+    """
+
+    def rise(H, ls):
+        a = w * ls / H
+        return (H / w) * a * a / (math.sqrt(1.0 + a * a) + 1.0) + w * ls * ls / (2.0 * EA)
+
+    def suspended(H):
+        if rise(H, L0) < height:
+            raise ValueError("the line cannot reach the fairlead with a part on the seabed")
+        return brentq(lambda ls: rise(H, ls) - height, 0.0, L0, xtol=1e-300, rtol=_RTOL,
+                      maxiter=500)
+
+    def span_of(H):
+        ls = suspended(H)
+        return (L0 - ls) + (H / w) * math.asinh(w * ls / H) + H * L0 / EA - span
+
+    lo = 1e-9 * w * L0
+    hi = w * L0
+    while span_of(hi) < 0.0:
+        hi *= 2.0
+    H = brentq(span_of, lo, hi, xtol=1e-300, rtol=_RTOL, maxiter=500)
+    ls = suspended(H)
+    LB = L0 - ls
+    V = w * ls
+    return {"H": H, "V": V, "lying_length": LB, "touchdown_x": LB * (1.0 + H / EA),
+            "fairlead_tension": math.hypot(H, V), "anchor_tension": H}
 
 
 def string_with_damper(a_over_l: float, eta: float, mode: int = 1) -> complex:

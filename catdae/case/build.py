@@ -19,12 +19,13 @@ from pydantic import BaseModel, ValidationError
 from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
 from catdae.case.build_connectors import _ConnectorsPass, connector_ends
 from catdae.case.build_fluid import _FluidPass
+from catdae.case.build_seabed import _SeabedPass
 from catdae.case.build_steps import _StepsPass
 from catdae.case.build_time import _TimePass
 from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
 from catdae.case.ground import _GroundPass
-from catdae.case.limits import size_problems
+from catdae.case.limits import MAX_NAME_LENGTH, size_problems
 from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
 from catdae.case.model import (
     AXES,
@@ -43,9 +44,23 @@ from catdae.case.schema import (
 from catdae.case.sweep import _SweepPass
 from catdae.errors import CaseError
 
+# bidirectional formatting: embeddings, overrides, isolates (and in names the marks too)
+_BIDI_OVERRIDES = frozenset("\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+_BIDI = _BIDI_OVERRIDES | frozenset("\u200e\u200f\u061c")
+
+
+MAX_MESSAGE = 400  # characters of one problem: a name of 100 000 characters is not repeated
+
+
+def _bounded(message: str) -> str:
+    """A message cut to MAX_MESSAGE characters, saying so (it may quote a long name)."""
+    if len(message) <= MAX_MESSAGE:
+        return message
+    return f"{message[:MAX_MESSAGE - 40]}... (message cut, {len(message)} characters)"
+
 
 class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, _FluidPass,
-               _GroundPass):
+               _GroundPass, _SeabedPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -54,7 +69,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         self.problems: list[tuple[str, str]] = []
 
     def problem(self, parts: Iterable[str | int], message: str) -> None:
-        self.problems.append((_fmt_path(parts), message))
+        self.problems.append((_fmt_path(parts), _bounded(message)))
 
     def validate(self, model: type[BaseModel], data: Any, prefix: tuple,
                  foreign: Mapping[str, str] | None = None) -> tuple[Any, bool]:
@@ -122,6 +137,9 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
         self.fluid_lines(top.materials, water, air)
+        seabed = self.seabed(top.seabed, nodes, supports, materials, steps,
+                             water_floor=None if water is None or not math.isfinite(water.depth)
+                             else water.surface - water.depth)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -134,8 +152,9 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
             supports=FrozenMap(supports), cables=tuple(c for _, c in cables.values()),
             point_masses=tuple(point_masses), loads=tuple(loads),
             distributed_loads=tuple(distributed), support_motions=tuple(motions),
-            **connectors, steps=tuple(steps), water=water, air=air, path=self.path, text=text,
-            name=name, reference_temperature=top.reference_temperature, ground=ground,
+            **connectors, steps=tuple(steps), water=water, air=air, seabed=seabed,
+            path=self.path, text=text, name=name,
+            reference_temperature=top.reference_temperature, ground=ground,
         )
         problems = size_problems(case)  # counts and sizes, before any work
         if problems:
@@ -143,23 +162,36 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         return case
 
     def names(self, top: _Top) -> None:
-        """Names and texts end up in the results file: no control characters (netCDF cuts a
-        string at NUL)."""
+        """Names and texts end up in the results file, in messages and in ParaView: no control
+        characters (netCDF cuts a string at NUL), no bidirectional controls (U+202E shows a
+        name reversed), and names of at most MAX_NAME_LENGTH characters (every mesh node and
+        element label repeats its cable's name)."""
         found: list[tuple[tuple, str]] = [(("title",), top.title), (("source",), top.source)]
         found += [(("materials", k), k) for k in top.materials]
         found += [(("nodes", k), k) for k in top.nodes]
         for section in ("cables", "point_masses", "loads", "distributed_loads", "springs",
-                        "dampers", "bars"):  # steps:
-            # their names are held to the stricter rule of group names (steps())
+                        "dampers", "bars", "steps"):
+            # step names are also held to the stricter rule of group names (steps())
             found += [((section, i, "name"), item["name"]) for i, item in
-                      enumerate(getattr(top, section)) if isinstance(item.get("name"), str)]
+                      enumerate(getattr(top, section))
+                      if isinstance(item, dict) and isinstance(item.get("name"), str)]
         for where, text in found:
-            allowed = "\n\t" if where[0] in ("title", "source") else ""
+            text_field = where[0] in ("title", "source")
+            allowed = "\n\t" if text_field else ""
             bad = [c for c in text if unicodedata.category(c) == "Cc" and c not in allowed]
+            bidi = [c for c in text if c in (_BIDI_OVERRIDES if text_field else _BIDI)]
+            if where[0] == "steps" and (bad or bidi):
+                continue  # refused by the rule of group names (steps())
             if bad:
                 self.problem(where, f"expected text without control characters, found "
                              f"{_short(text)} (U+{ord(bad[0]):04X})")
-
+            elif bidi:
+                self.problem(where, "expected text without bidirectional control characters "
+                             f"(they reorder what is shown), found U+{ord(bidi[0]):04X} in "
+                             f"{_short(text.encode('unicode_escape').decode('ascii'))}")
+            elif not text_field and len(text) > MAX_NAME_LENGTH:
+                self.problem(where, f"a name of {len(text)} characters, above the limit of "
+                             f"{MAX_NAME_LENGTH}; found {_short(text)}")
 
     def gravity_vector(self, raw: Any) -> tuple[float, tuple[float, float, float]]:
         """``gravity``: a number (m/s², along -z) or ``[gx, gy, gz]``; returns (|g|, unit)."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 import warnings
 from collections.abc import Mapping
 
@@ -20,6 +21,9 @@ from catdae.case.schema import (
 )
 from catdae.case.timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
 from catdae.case.timefunc_compose import Product, Trapezoid
+
+_OVERFLOW = ("its value, rate or second derivative overflows (not a finite number): check the "
+             "amplitude against the duration, the frequency or the spacing of the points")
 
 
 class _TimePass:
@@ -66,9 +70,7 @@ class _TimePass:
         else:
             tf = self.table(v, where, motion)
         if tf is not None and not _finite(tf):
-            self.problem(where, "its value, rate or second derivative overflows (not a "
-                         "finite number): check the amplitude against the duration, the "
-                         "frequency or the spacing of the points")
+            self.problem(where, _OVERFLOW)
             return None
         return tf
 
@@ -133,14 +135,19 @@ class _TimePass:
                              f"{t[j - 1]:g} then {t[j]:g} (point {j})")
                 return None
         t, value = tuple(float(x) for x in t), tuple(float(x) for x in value)
-        if v.quantity == "acceleration":
-            return AccelerationRecord(t, value, v.file, v.column)
-        if v.quantity == "velocity":
-            return VelocityRecord(t, value, v.file, v.column)
         with np.errstate(all="ignore"), warnings.catch_warnings():
-            # points too close for their values overflow the spline: judged by _finite
+            # points too close for their values overflow the spline (judged by _finite), or
+            # values near 1e308 overflow its slopes (scipy refuses them: the same problem)
             warnings.simplefilter("ignore", RuntimeWarning)
-            return Table(t, value, v.file)
+            try:
+                if v.quantity == "acceleration":
+                    return AccelerationRecord(t, value, v.file, v.column)
+                if v.quantity == "velocity":
+                    return VelocityRecord(t, value, v.file, v.column)
+                return Table(t, value, v.file)
+            except (ValueError, OverflowError, ZeroDivisionError):
+                self.problem(where, _OVERFLOW)
+                return None
 
     def read_csv(self, name: str, where: tuple, column: str | None = None,
                  column_where: tuple = ()) -> list[tuple[float, float]] | None:
@@ -163,16 +170,27 @@ class _TimePass:
             self.problem(where, f"cannot read table file {_short(name)}: not UTF-8 text "
                          f"(byte {exc.start})")
             return None
-        lines = [(n, [c.strip() for c in row])
-                 for n, row in enumerate(csv.reader(text.splitlines()), start=1)]
-        lines = [(n, c) for n, c in lines if any(c) and not c[0].startswith("#")]
+        lines = []
+        reader = csv.reader(text.splitlines())
+        while True:
+            try:
+                row = next(reader)
+            except StopIteration:
+                break
+            except csv.Error as exc:  # a field over the csv module's limit, a stray quote...
+                self.problem(where, f"{_short(name)}, line {reader.line_num}: not readable "
+                             f"as CSV ({str(exc)[:80]})")
+                return None
+            cells = [c.strip() for c in row]
+            if any(cells) and not cells[0].startswith("#"):
+                lines.append((reader.line_num, cells))
         header: list[str] | None = None
         if lines and not all(_is_float(c) for c in lines[0][1]):
             header = lines[0][1]  # a header line such as "time,value" or "t,ax,ay,az"
             lines = lines[1:]
         width = len(header) if header is not None else len(lines[0][1]) if lines else 2
         if column is None and width != 2:
-            names = f" ({', '.join(header)})" if header is not None else ""
+            names = f" ({_columns(header)})" if header is not None else ""
             self.problem(where, f"{name} has {width} columns{names}: choose the value column "
                          'with column = "<name>" (time is the first column)')
             return None
@@ -183,9 +201,11 @@ class _TimePass:
                              "naming its columns, time first (e.g. t,ax,ay,az); found none")
                 return None
             if column not in header[1:]:
+                listed = _listed(header)
                 hint = (f"{column!r} is the time column" if column == header[0] else
-                        f"{name} has no column {column!r}{_suggest(column, header[1:])} (its "
-                        f"columns: {', '.join(header)}; time is the first)")
+                        f"{name} has no column {_short(column)}"
+                        f"{_suggest(column, header[1:]) if listed else ''} (its columns: "
+                        f"{_columns(header)}; time is the first)")
                 self.problem(column_where, hint)
                 return None
             index = header.index(column)
@@ -222,6 +242,23 @@ def _finite(tf: TimeFunction) -> bool:
     with np.errstate(all="ignore"):
         values = tf.evaluate(np.asarray(ts, float))
     return all((np.isfinite(v) & (np.abs(v) < 1e150)).all() for v in values)
+
+
+_LABEL = re.compile(r"[A-Za-z_][A-Za-z0-9_.()/ -]{0,31}")
+MAX_LISTED_COLUMNS = 20
+
+
+def _listed(header: list[str]) -> bool:
+    """Whether a header line is a short list of column names, shown in messages; any other
+    line (long, many columns, odd characters) is described, never quoted."""
+    return len(header) <= MAX_LISTED_COLUMNS and all(_LABEL.fullmatch(c) for c in header)
+
+
+def _columns(header: list[str]) -> str:
+    if _listed(header):
+        return ", ".join(header)
+    return (f"{len(header)} columns, not listed: the header line is not a short list of "
+            "names")
 
 
 def _is_float(cell: str) -> bool:

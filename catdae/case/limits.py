@@ -10,13 +10,18 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import stat
 from pathlib import Path
 
 MAX_FILE_BYTES = 16 * 2**20  # a case file or a table file
 MAX_ELEMENTS_PER_CABLE = 10_000  # a transient at 1000 elements already costs ~670 s per s
 MAX_DOFS = 300_000  # 3 per node, all cables together
-MAX_STEP_BYTES = 2**30  # what one step keeps in memory and writes (float64 values)
+MAX_STEP_BYTES = 2**30  # the memory one step needs: what it keeps and writes, working copies too
+WORKING_COPIES = 3  # a transient step needs about 2.7 times what it stores while it runs
+MAX_SIMULATED_TIME = 1e7  # s (about 116 days): the transient steps of a case together
+MAX_NAME_LENGTH = 100  # characters of a name (cable, node, material, load, step, ...)
+MAX_KEY_PARTS = 64  # parts of one dotted TOML key (a.b.c has 3), judged before parsing
 MIN_TIME = 1e-9  # s: shortest step duration, output interval or ramp duration
 MAX_FREQUENCY = 1e9  # Hz, of a sine or cosine time function
 TABLE_ROOTS_ENV = "CATDAE_TABLE_ROOTS"  # more folders table files may be read from
@@ -100,10 +105,10 @@ def transient_bytes(n_out: float, n_nodes: int, n_elements: int) -> float:
 
 
 def modal_bytes(modes: int, n_free: int, n_nodes: int, dense: bool) -> float:
-    """Mode shapes (modes, n_nodes, 3); with the dense solver, K and M (n_free²) and the
-    eigenvectors too."""
+    """Mode shapes (modes, n_nodes, 3); with the dense solver, K and M (n_free²), the
+    eigenvectors and the solver's working copies of K and M too."""
     k = min(modes, n_free)
-    return 8.0 * (k * 3 * n_nodes + (3.0 * n_free * n_free if dense else 2.0 * k * n_free))
+    return 8.0 * (k * 3 * n_nodes + (5.0 * n_free * n_free if dense else 2.0 * k * n_free))
 
 
 def size_problems(case) -> list[tuple[str, str]]:
@@ -122,12 +127,13 @@ def size_problems(case) -> list[tuple[str, str]]:
         if step.kind == "transient":
             n_out = output_count(step.duration, step.output_interval)
             size = transient_bytes(n_out, n_nodes, n_elements)
-            if size > MAX_STEP_BYTES:
+            if WORKING_COPIES * size > MAX_STEP_BYTES:
                 problems.append((f"steps[{i}].output_interval", (
                     f"transient step '{step.name}' would store {n_out:.4g} outputs of "
-                    f"{n_nodes} nodes and {n_elements} elements, {human_bytes(size)}, above the "
-                    f"limit of {human_bytes(MAX_STEP_BYTES)} per step; make output_interval "
-                    "longer, the duration shorter, or split the step")))
+                    f"{n_nodes} nodes and {n_elements} elements, {human_bytes(size)}, and need "
+                    f"about {human_bytes(WORKING_COPIES * size)} of memory with its working "
+                    f"copies, above the limit of {human_bytes(MAX_STEP_BYTES)} per step; make "
+                    "output_interval longer, the duration shorter, or split the step")))
         elif step.kind == "modal":
             size = modal_bytes(step.modes, n_free, n_nodes, dense=step.modes >= n_free - 1)
             if size > MAX_STEP_BYTES:
@@ -135,4 +141,30 @@ def size_problems(case) -> list[tuple[str, str]]:
                     f"modal step '{step.name}': {min(step.modes, n_free)} modes of {n_free} "
                     f"free degrees of freedom need {human_bytes(size)}, above the limit of "
                     f"{human_bytes(MAX_STEP_BYTES)} per step; ask for fewer modes")))
+    total = sum(s.duration for s in case.steps if s.kind == "transient")
+    if total > MAX_SIMULATED_TIME:
+        problems.append(("steps", f"the transient steps simulate {total:.4g} s together, above "
+                         f"the limit of {MAX_SIMULATED_TIME:g} s (about 116 days) of simulated "
+                         "time per case; shorten the durations"))
     return problems
+
+
+_PART = r"""(?:[A-Za-z0-9_-]+|"(?:[^"\\\n]|\\.)*"|'[^'\n]*')"""
+_DOTTED = re.compile(rf"(?:[ \t]*\.[ \t]*{_PART})+")  # a run of ".part" on one line
+_SEPARATORS = re.compile(rf"[ \t]*\.[ \t]*(?={_PART})")
+
+
+def key_depth_problem(text: str) -> str | None:
+    """A dotted key of more than MAX_KEY_PARTS parts, judged before parsing (the TOML parser
+    takes time quadratic in the parts of one key: 50 000 parts of a 100 KB file take minutes).
+    Finds runs of ``.part`` (bare or quoted) on one line, in linear time; such a run inside a
+    string counts too, which no real case holds. Returns the message, or None."""
+    if text.count(".") < MAX_KEY_PARTS:
+        return None
+    for m in _DOTTED.finditer(text):
+        if m[0].count(".") >= MAX_KEY_PARTS and \
+                len(_SEPARATORS.findall(m[0])) >= MAX_KEY_PARTS:
+            line = text.count("\n", 0, m.start()) + 1
+            return (f"line {line}: a dotted key of more than {MAX_KEY_PARTS} parts, above the "
+                    f"limit of {MAX_KEY_PARTS} parts per key")
+    return None

@@ -9,6 +9,7 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+MAX_KEY_SHOWN = 60  # characters of one key of a field path in a message
 
 
 def _fmt_path(parts: Iterable[str | int]) -> str:
@@ -18,6 +19,8 @@ def _fmt_path(parts: Iterable[str | int]) -> str:
         if isinstance(p, int):
             out += f"[{p}]"
         else:
+            if len(p) > MAX_KEY_SHOWN:  # a key of 100 000 characters is named, not repeated
+                p = f"{p[:MAX_KEY_SHOWN - 20]}...({len(p)} characters)"
             if not _BARE_KEY.fullmatch(p):
                 p = '"' + p.replace("\\", "\\\\").replace('"', '\\"') + '"'
             out += f".{p}" if out else p

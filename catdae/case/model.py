@@ -222,7 +222,7 @@ class Damping:
 class AxialDamping:
     """Strain-rate (Kelvin-Voigt) damping of a transient step: a share ``ratio`` of critical at
     ``frequency`` (Hz), or at each element's highest axial frequency (``"element"``); it acts
-    on the axial strain rate only (docs/theory.md §17)."""
+    on the axial strain rate only (docs/theory.md §18)."""
 
     ratio: float
     frequency: float | Literal["element"] = "element"
@@ -271,6 +271,21 @@ class Step:
 
 
 @dataclass(frozen=True)
+class Seabed:
+    """A flat seabed at height ``z`` (m, along "up" = -gravity). ``stiffness`` Pa/m (None:
+    rigid, static steps only) and ``damping`` Pa s/m act per unit contact area (diameter ×
+    unstrained length); Coulomb ``friction_axial``/``friction_lateral`` coefficients, smoothed
+    below ``friction_velocity`` (m/s). docs/theory.md §17."""
+
+    z: float
+    stiffness: float | None = None
+    damping: float = 0.0
+    friction_axial: float = 0.0
+    friction_lateral: float = 0.0
+    friction_velocity: float = 0.01
+
+
+@dataclass(frozen=True)
 class Case:
     """A validated scene and its analysis steps. Build it with :func:`load_case`.
 
@@ -302,6 +317,7 @@ class Case:
     ground: Any = None  # catdae.case.ground.Ground: clearance results
     water: Water | None = None  # docs/case-format.md, "Water and air"
     air: Air | None = None
+    seabed: Seabed | None = None
     path: str | None = None
     text: str = field(default="", repr=False)
     name: str = "case"

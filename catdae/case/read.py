@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from catdae.case.build import _Builder
-from catdae.case.limits import FileProblem, read_limited
+from catdae.case.limits import FileProblem, key_depth_problem, read_limited
 from catdae.case.messages import _found
 from catdae.case.model import Case
 from catdae.errors import CaseError
@@ -46,6 +46,8 @@ def load_case(path_or_text: str | os.PathLike, *, name: str | None = None) -> Ca
         raise CaseError(None, [("", "expected a path or TOML text, found "
                                     f"{type(path_or_text).__name__}")])
     text = text.removeprefix("\ufeff")
+    if (deep := key_depth_problem(text)) is not None:  # before parsing: its cost is quadratic
+        raise CaseError(path, [("", deep)])
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -46,6 +46,7 @@ class _Top(BaseModel):
     dampers: list[TomlTable] = []
     bars: list[TomlTable] = []
     steps: list[TomlTable] = []
+    seabed: TomlTable | None = None
     water: Any = None  # [water] and [air]: checked by build_fluid
     air: Any = None
     ground: TomlTable | None = None  # catdae.case.ground

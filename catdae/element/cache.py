@@ -20,7 +20,8 @@ from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
                   "element/mass_gradient", "element/residual_kernel", "element/fluid_kernel",
-                  "element/fluid_kinematics", "solvers/axial_damping", "solvers/envelope")
+                  "element/fluid_kinematics", "element/grounded", "solvers/axial_damping",
+                  "solvers/envelope")
 _STAMP = "catdae-kernels.sha256"
 
 

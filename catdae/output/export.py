@@ -23,6 +23,7 @@ import numpy as np
 
 from catdae._xr import xr
 from catdae.errors import CatdaeError
+from catdae.interrupts import deferred
 
 
 class ExportError(CatdaeError):
@@ -38,6 +39,10 @@ def _cells(ds: xr.Dataset) -> np.ndarray:
 def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str) -> Path:
     """One step's time series: the ``.vtu`` files and the ``.pvd`` collection; returns the
     collection's path."""
+    from catdae.output.reading import step_problem
+
+    if (why := step_problem(ds)) is not None:
+        raise ExportError(f"step {name[:60]!r}: {why}")
     if "element_node" not in ds.coords:
         raise ExportError(f"step {name!r} has no elements to export (a {ds.attrs.get('kind')} "
                           "step)")
@@ -59,12 +64,15 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str) -> Path:
                        "tension_j": [tens[:, 1]]},
         )
         f = sub / f"{name}_{k:05d}.vtu"
-        meshio.write(f, mesh, file_format="vtu")
+        with deferred():  # a signal waits until the file is complete
+            meshio.write(f, mesh, file_format="vtu")
         entries.append(f'    <DataSet timestep="{float(t)!r}" part="0" '
                        f'file={quoteattr(f.relative_to(folder).as_posix())}/>')
     pvd = folder / f"{name}.pvd"
-    pvd.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
-                   "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
+    with deferred():
+        pvd.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+                       "  <Collection>\n" + "\n".join(entries)
+                       + "\n  </Collection>\n</VTKFile>\n")
     return pvd
 
 

@@ -27,6 +27,7 @@ from matplotlib.figure import Figure
 
 from catdae._xr import xr
 from catdae.errors import CatdaeError
+from catdae.interrupts import deferred
 from catdae.output.plot_envelopes import mark_peaks, reactions
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
@@ -50,8 +51,32 @@ def _subplots(*args, figsize, **kwargs):
     return fig, fig.subplots(*args, **kwargs)
 
 
-def _ds(data) -> xr.Dataset:
-    return data.to_dataset() if isinstance(data, xr.DataTree) else data
+_KINDS = {"profile": ("static", "transient"), "tension": ("static", "transient"),
+          "history": ("transient",), "spectrum": ("transient",), "modes": ("modal",)}
+
+
+def _ds(data, figure: str | None = None) -> xr.Dataset:
+    """The step's Dataset, judged for the figure: PlotError unless it is a step group of a
+    kind that makes it, with the variables of that kind (results.step_problem)."""
+    from catdae.output.reading import step_problem
+
+    if isinstance(data, xr.DataTree):
+        data = data.to_dataset()
+    if not isinstance(data, xr.Dataset):
+        raise PlotError(f"expected a step of a results tree (an xarray Dataset or DataTree "
+                        f"node), found {type(data).__name__}")
+    if figure is not None:
+        why = step_problem(data)
+        if why is not None:
+            raise PlotError(f"cannot draw a {figure} figure of this group: {why}")
+        kinds = _KINDS[figure]
+        if data.attrs["kind"] not in kinds:
+            raise PlotError(f"a {figure} figure needs a {' or '.join(kinds)} step, found a "
+                            f"{data.attrs['kind']} step")
+        if "time" in data.dims and data.sizes["time"] == 0:
+            raise PlotError(f"the step has no outputs to draw (status: "
+                            f"{str(data.attrs.get('status', ''))[:80]})")
+    return data
 
 
 def cable_paths(ds: xr.Dataset) -> dict[str, list[str]]:
@@ -77,13 +102,20 @@ def _times(ds: xr.Dataset, times) -> np.ndarray:
     t = ds.time.values
     if times is None:
         return t[np.unique(np.linspace(0, t.size - 1, min(5, t.size)).round().astype(int))]
-    return np.array([t[np.abs(t - float(x)).argmin()] for x in np.atleast_1d(times)])
+    try:
+        wanted = np.atleast_1d(np.asarray(times, dtype=float))
+    except (TypeError, ValueError):
+        raise PlotError(f"times: expected numbers (s), found {times!r:.60}") from None
+    if wanted.ndim != 1 or wanted.size == 0 or not np.isfinite(wanted).all():
+        raise PlotError(f"times: expected one or more finite times (s), found "
+                        f"{np.array2string(wanted, threshold=6)}")
+    return np.array([t[np.abs(t - x).argmin()] for x in wanted])
 
 
 def profile(data, times=None, what: str = "position") -> Figure:
     """The cable at the given times (nearest stored ones; static: its one state): elevation
     (x-z) above, plan (x-y) below."""
-    ds = _ds(data)
+    ds = _ds(data, "profile")
     var = ds[what]
     fig, (ax_e, ax_p) = _subplots(2, 1, figsize=(8, 7), sharex=True)
     states = [(None, var)] if "time" not in var.dims else [
@@ -188,7 +220,7 @@ def select_node(ds: xr.Dataset, spec: str) -> str:
 def history(data, node: str | None = None) -> Figure:
     """Displacement of a node over time, one panel per axis (default node: the free node that
     moves most)."""
-    ds = _ds(data)
+    ds = _ds(data, "history")
     node = _node(ds, node)
     d = ds.displacement.sel(node=node)
     fig, axes = _subplots(3, 1, figsize=(8, 7), sharex=True)
@@ -216,7 +248,7 @@ def amplitude_spectrum(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.nda
 
 def spectrum(data, node: str | None = None) -> Figure:
     """Amplitude spectrum of a node's displacement, per axis (log scale)."""
-    ds = _ds(data)
+    ds = _ds(data, "spectrum")
     node = _node(ds, node)
     t = ds.time.values
     if t.size < 4 or not np.allclose(np.diff(t), np.diff(t)[0], rtol=1e-6, atol=1e-12):
@@ -237,7 +269,7 @@ def spectrum(data, node: str | None = None) -> Figure:
 def tension(data, times=None) -> Figure:
     """Tension along each cable (element ends at their arc length s; transient: at chosen
     times) and, for a transient, the force on the cable at each support over time."""
-    ds = _ds(data)
+    ds = _ds(data, "tension")
     transient = "time" in ds.tension.dims
     fig, axes = _subplots(2 if transient else 1, 1, figsize=(8, 7 if transient else 4))
     ax_s = axes[0] if transient else axes
@@ -274,8 +306,10 @@ def tension(data, times=None) -> Figure:
 def modes(data, n: int = 6) -> Figure:
     """The first n mode shapes: elevation (x-z components against x) and plan (y), each
     titled with its frequency."""
-    ds = _ds(data)
-    n = min(n, ds.mode.size)
+    ds = _ds(data, "modes")
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+        raise PlotError(f"n: expected the number of modes to draw, an integer >= 1, found {n!r}")
+    n = min(int(n), ds.mode.size)
     fig, axes = _subplots(n, 1, figsize=(8, 1.9 * n + 0.6), sharex=True, squeeze=False)
     paths = _paths(ds)
     x_of = ds.reference_position.sel(axis="x") if "reference_position" in ds else None
@@ -314,16 +348,25 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
     """PNG files ``<step>-<what>.png`` into ``folder`` for every figure that each step's kind
     can make (profile, tension: all; history, spectrum: transient; modes: modal)."""
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    names = list(tree.children) if not steps else list(steps)
+    names = list(tree.children) if not steps else [steps] if isinstance(steps, str) else list(
+        steps)
     unknown = [s for s in names if s not in tree.children]
     if unknown:
-        raise PlotError(f"no step {unknown[0]!r} in the results (steps: "
-                        f"{', '.join(tree.children)})")
-    wanted = tuple(what) if what else WHAT
+        raise PlotError(f"no step {str(unknown[0])[:60]!r} in the results (steps: "
+                        f"{', '.join(tree.children) or 'none'})")
+    wanted = (what,) if isinstance(what, str) else tuple(what) if what else WHAT
+    bad = [w for w in wanted if w not in WHAT]
+    if bad:
+        raise PlotError(f"what: no figure {str(bad[0])[:40]!r}; expected some of "
+                        f"{', '.join(WHAT)}")
+    folder.mkdir(parents=True, exist_ok=True)
     written = []
+    from catdae.output.reading import step_problem
+
     for name in names:
         ds = tree[name].to_dataset()
+        if (why := step_problem(ds)) is not None:
+            raise PlotError(f"step {name[:60]!r}: {why}")
         kind = ds.attrs.get("kind")
         can = {"static": ("profile", "tension"), "modal": ("modes",),
                "transient": ("profile", "history", "spectrum", "tension", "reactions")
@@ -333,13 +376,16 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
                 continue
             fig = _figure(w, ds, node, times)
             path = folder / f"{name}-{w}.png"
-            fig.savefig(path, dpi=120)
+            with deferred():  # a signal waits until the file is complete
+                fig.savefig(path, dpi=120)
             written.append(path)
     if "spans" in wanted:  # one figure across the static steps (catdae.output.plot_spans)
         from catdae.output.plot_spans import spans, static_groups
 
         if len(static_groups(tree, steps)) >= 2:
             path = folder / "spans.png"
-            spans(tree, steps).savefig(path, dpi=120)
+            fig = spans(tree, steps)
+            with deferred():
+                fig.savefig(path, dpi=120)
             written.append(path)
     return written

@@ -10,7 +10,6 @@ from __future__ import annotations
 import errno
 import os
 import shutil
-import uuid
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -19,6 +18,7 @@ import numpy as np
 from catdae._version import __version__
 from catdae._xr import xr
 from catdae.model.mesh import AXES, Mesh
+from catdae.output.files import INCOMPLETE_SUFFIX, clean_stale, incomplete_name  # noqa: F401
 
 CONVENTIONS = "CF-1.10"
 # CF §4.4: a time coordinate has units "<unit> since <epoch>". The case's clock has no date: its
@@ -148,7 +148,7 @@ def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, 
     coords = _coords(mesh)
     coords["time"] = xr.Variable("time", np.asarray(time, float), TIME_ATTRS,
                                  encoding={"_FillValue": None})  # CF: none on coordinates
-    X = np.asarray(X).reshape(len(time), -1, 3)
+    X = np.asarray(X).reshape(len(time), mesh.X0.shape[0], 3)  # 0 outputs too: an early stop
     data = {
         "position": _var(d, X, "m", "node position"),
         "displacement": _var(d, X - mesh.X0[None], "m", "displacement from reference_position"),
@@ -191,22 +191,12 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 
 
-INCOMPLETE_SUFFIX = ".incomplete"
-"""The temporary name ends so: ``<name>.<pid>-<random>.incomplete``, never ``.nc``."""
-
-
-def incomplete_name(path: Path) -> Path:
-    """The temporary file that :func:`write_atomic` writes before moving it to ``path``. Only a
-    process killed outright (SIGKILL, power loss) leaves one behind; its name says what it is
-    and no ``*.nc`` pattern matches it, so it is never taken for a result."""
-    return path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}{INCOMPLETE_SUFFIX}")
-
-
 def write_atomic(data: xr.DataTree | xr.Dataset, path: str | os.PathLike) -> Path:
     """Write netCDF-4 atomically: a temporary file beside the target (:func:`incomplete_name`),
     moved over it, so that a crash never leaves half a file and an existing file is only
     replaced by a complete one. Raises OSError when the file cannot be written."""
     path = Path(path)
+    clean_stale(path.parent, path.name + ".")
     tmp = incomplete_name(path)
     try:
         data.to_netcdf(tmp, engine="netcdf4")

@@ -20,6 +20,9 @@ def dataset(rec) -> xr.Dataset:
     }
     ds = results.transient_dataset(rec.mesh, rec.times[sl], rec.X[sl], rec.V[sl], rec.A[sl],
                                    rec.T[sl], rec.R[sl], energy, dict(rec.attrs))
+    if rec.work is not None:
+        ds["energy_fluid_work"] = xr.Variable("time", rec.W[sl], {
+            "units": "J", "long_name": "work done on the cables by the water and the air"})
     ds = with_connector_forces(ds, rec.prob.model.connectors, rec.X[sl], rec.V[sl])
     fl = rec.prob.model.fluid  # water and air: surface elevation, fluid velocity
     if fl is not None:

@@ -1,4 +1,4 @@
-"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §17).
+"""Axial (strain-rate, Kelvin-Voigt) damping of the catenary elements (docs/theory.md §18).
 
 A Kelvin-Voigt material carries, besides its elastic tension, a viscous tension η A ε̇ on the
 rate of axial strain only. An element's strain is that of its catenary: the elastic elongation

@@ -1,5 +1,5 @@
 """The tension envelope of a transient step: per element end, the largest and the smallest
-tension and when, over every accepted integrator step and every output (docs/theory.md §17.3).
+tension and when, over every accepted integrator step and every output (docs/theory.md §18.3).
 
 The outputs sample the motion every ``output_interval``; a snap's peak lasts about one wave
 transit of an element (a fraction of a millisecond on a steel wire) and falls between them. The

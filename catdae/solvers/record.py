@@ -9,6 +9,7 @@ import numpy as np
 
 from catdae.model.assembly import Model
 from catdae.solvers.envelope import TensionEnvelope
+from catdae.solvers.fluid_work import FluidWork
 
 _GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
 
@@ -29,6 +30,9 @@ class OutputRecord:
         self.T = np.full((times.size, ne, 2), np.nan)  # (n_out, n_elem, 2) N, end tensions
         self.R = np.full_like(self.X, np.nan)  # N, support reactions (NaN on free axes)
         self.E = np.full((times.size, 3), np.nan)  # J: kinetic, strain, potential
+        # J: work of the water and air (docs/theory.md §13.5); None without a fluid
+        self.work = FluidWork(prob) if prob.model.fluid is not None else None
+        self.W = np.full(times.size, np.nan)
         self.n_valid = 0
         self.attrs: dict = {}
         self.envelope = TensionEnvelope(prob)  # every accepted step and every output
@@ -38,6 +42,8 @@ class OutputRecord:
         self.X[k], self.V[k], self.A[k] = X.reshape(-1, 3), V.reshape(-1, 3), A.reshape(-1, 3)
         self.T[k], self.R[k], self.E[k] = T, R, E
         self.envelope.update(t, tension=T)
+        if self.work is not None:
+            self.W[k] = self.work.at(t, y, yp)
 
     def upto(self, n_valid: int, attrs: dict) -> OutputRecord:
         """This record with its first ``n_valid`` outputs valid and ``attrs`` set."""

@@ -46,6 +46,7 @@ from catdae.element.elements import NOT_CONVERGED, ElementState, _dynamic_forces
 from catdae.element.residual_kernel import residual_pass
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.seabed import SeabedContact
 from catdae.model.settings import DampingModel
 from catdae.solvers.axial_damping import AxialDamping
 from catdae.solvers.connector_terms import ConnectorTerms
@@ -104,7 +105,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
         self.velocity_jumps: list[tuple[float, float, float]] = []
         self.n_rejected = 0
         self._fast_setup()
-        self.axial = AxialDamping.of(model, step, self.fidx)  # docs/theory.md §17, or None
+        # the seabed's penalty contact (docs/theory.md §17); None for a scene without one
+        self.seabed = SeabedContact.of_step(model)
+        self.axial = AxialDamping.of(model, step, self.fidx)  # docs/theory.md §18, or None
 
     def _fast_setup(self) -> None:
         """Flags and buffers of the compiled residual (``residual_kernel.residual_pass``)."""
@@ -178,6 +181,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
         self._buffers_at = (t, np.array(y[0::2], copy=True))
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
+        if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §17)
+            res[1::2] -= self.seabed.forces(self._Xb.reshape(-1, 3),
+                                            self._Vb.reshape(-1, 3)).ravel()[self._fidx]
         return True
 
     def _conf_from_buffers(self):
@@ -258,6 +264,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
             out += self.connectors.force(self.X, V, A, self.alpha)
         if m.fluid is not None:
             out += m.fluid.evaluate(t, self._conf_X(), V, A)[0]
+        if self.seabed is not None:
+            out -= self.seabed.forces(self._conf_X().reshape(-1, 3), V.reshape(-1, 3)).ravel()
         if self.axial is not None:
             self.axial.add_forces(out, self.X, V, state)
         return out
@@ -342,6 +350,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
             pat = self.model.pattern
             kdata = kdata + pat.assemble(kx)
             vdata = vdata + pat.assemble(cj * ma + kv)
+        if self.seabed is not None:  # docs/theory.md §17: -∂f/∂q, -∂f/∂v of the contact
+            V, _ = self.full_vectors(t, y[1::2], yp[1::2])
+            kdata, vdata = self.seabed.add_derivatives(kdata, vdata, self._conf_X(), V)
         if self.axial is not None:
             vdata = vdata + self.axial.velocity_data(self, t, y, yp, conf)
         sel = self.ff_sel
@@ -403,6 +414,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms):
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)
+        if self.seabed is not None:  # the contact springs' energy (docs/theory.md §17)
+            gravity += self.seabed.energy(X.reshape(-1, 3))
         if self.connectors is not None:
             kinetic, strain = self._connector_energies(X, V, kinetic, strain)
         return (X, V, A, tension, reaction.reshape(-1, 3),

@@ -208,6 +208,9 @@ class _Run:
         solver = self.make_solver(self.options["max_order"])
         solver.init_step(self.t0, self.y0, self.yp0)
         record(0, self.t0, self.y0, self.yp0)
+        work = self.outputs.work  # the fluid's work, None without a fluid
+        if work is not None:
+            work.advance(self.t0, self.y0, self.yp0)
         self.k_done = 1
         t_int = self.t0
         stalled = 0
@@ -237,9 +240,13 @@ class _Run:
             at_stop = ((t_stop < t_end or end_jump)
                        and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0))
             self._record_passed(solver, t_int, y_last, yp_last, at_stop)
+            if work is not None:
+                work.advance(t_int, y_last, yp_last)
             if at_stop:
                 t_int = t_stop
                 y_last, yp_last = prob.restart(t_stop, y_last, befores[i_stop])
+                if work is not None:
+                    work.advance(t_int, y_last, yp_last)
                 self.n_restarts += 1
                 i_stop += 1
                 if i_stop < len(stops):

@@ -6,6 +6,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import signal
 import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import ExitStack
@@ -17,8 +18,10 @@ from catdae._version import __version__
 from catdae._xr import xr
 from catdae.analysis import as_case
 from catdae.case import AXES, Case, Step
+from catdae.case.limits import MAX_SIMULATED_TIME
 from catdae.case.names import cable_of
 from catdae.errors import CaseError
+from catdae.interrupts import deferred
 from catdae.study.core import (
     _COUNTS,
     StudyError,
@@ -57,9 +60,12 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
     """
     case = as_case(case)
     st = study_step(case, step)
-    if duration is not None and not (st.kind == "transient" and 0 < duration < math.inf):
-        raise StudyError(f"duration: expected a number > 0 for a transient step, found "
-                         f"{duration!r} ({st.kind} step {st.name!r})")
+    if duration is not None and not (st.kind == "transient"
+                                     and 0 < duration <= MAX_SIMULATED_TIME):
+        raise StudyError(f"duration: expected a number > 0 and <= {MAX_SIMULATED_TIME:g} s for "
+                         f"a transient step, found {duration!r} ({st.kind} step {st.name!r})")
+    if not (isinstance(workers, int) and workers >= 1):
+        raise StudyError(f"workers: expected an integer >= 1, found {workers!r}")
     grid = settings_grid(case, st, {"rtol": rtol, "atol": atol, "elements": elements,
                                     "gauss_points": gauss_points, "mass_model": mass_model,
                                     "linear_solver": linear_solver, "max_order": max_order})
@@ -98,12 +104,24 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         else:
             todo[key] = c
     by_key = dict(zip(keys, combos, strict=True))
-    for key, ds in _execute_all(todo, st.name, memory, scheduler, workers):
-        if store_dir is not None and not ds.attrs.get("lost"):
-            _store_write(store_dir, key, ds, by_key.get(key, ref_settings))
-        records[key] = ds
-        if on_run is not None:
-            on_run(by_key.get(key), ds)
+    interrupt: KeyboardInterrupt | None = None
+    try:
+        for key, ds in _execute_all(todo, st.name, memory, scheduler, workers):
+            if store_dir is not None and not ds.attrs.get("lost"):
+                with deferred():  # a signal waits until the stored run is complete
+                    _store_write(store_dir, key, ds, by_key.get(key, ref_settings))
+            records[key] = ds
+            if on_run is not None:
+                on_run(by_key.get(key), ds)
+    except KeyboardInterrupt as exc:  # a partial report of the finished runs, then it goes on
+        interrupt = exc
+        why = getattr(exc, "signum", None)
+        not_run = {"status": "not run (the study was interrupted"
+                   + (f" by {signal.Signals(why).name})" if why else ")"),
+                   "wall_time": math.nan, "peak_memory": math.nan,
+                   **{k: math.nan for k in _COUNTS}}
+        for key in [*([ref_key] if ref_key else []), *keys]:
+            records.setdefault(key, xr.Dataset(attrs=dict(not_run)))
     ref = ref_data if ref_data is not None else records[ref_key]
     out = _assemble(grid, combos, keys, records, ref, st, target)
     out.attrs.update(_clean({
@@ -122,6 +140,13 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
     out.attrs["reference_status"] = str(ref.attrs.get("status", "completed"))
     if not given_ref:
         out.attrs["reference_wall_time"] = float(ref.attrs["wall_time"])
+    finished = sum(not str(records[k].attrs.get("status", "")).startswith("not run")
+                   for k in keys)
+    out.attrs["status"] = "completed" if interrupt is None else (
+        f"interrupted: {finished} of {len(keys)} runs finished (a partial report)")
+    if interrupt is not None:
+        interrupt.partial = out
+        raise interrupt
     return out
 
 

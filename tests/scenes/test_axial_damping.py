@@ -1,5 +1,5 @@
 """Axial (strain-rate, Kelvin-Voigt) damping and the tension envelope, checked against closed
-forms and finite differences (docs/theory.md §17).
+forms and finite differences (docs/theory.md §18).
 
 - a mass on a taut weightless bar: the damping ratio read from the decay is ζ ω / ω_ref (a
   Kelvin-Voigt bar: the ratio grows with frequency), at two stated frequencies;

@@ -333,3 +333,26 @@ def test_conductor_gust_case_calm_then_swung_and_back():
     assert late.mean() > 3.0  # swung downwind
     assert np.ptp(late) < 0.2 * np.ptp(early)  # and settled while the wind holds
     assert abs(y[t >= 40].mean()) < 0.2 * late.mean()  # back after the gust
+
+
+# ------------------------------------------------------------------------------------------------
+# the energy balance with the work of the fluid
+# ------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("current", ["", "current = [0.3, 0.0, 0.1]\n"])
+def test_energy_balance_with_the_work_of_the_water(current):
+    """A line in water released from a pull (no structural damping, fixed supports): the
+    change of energy_total equals energy_fluid_work, the work of drag, added mass and the
+    current (docs/theory.md §13.5), to a small fraction of the energy the water takes."""
+    d = 0.1
+    area = math.pi * d * d / 4
+    extra = (f"{_water(current)}[[loads]]\nname = \"pull\"\nnode = \"c.4\"\n"
+             "force = [0.0, 2000.0, 1000.0]\n")
+    text = cable_scene(A=(0, 0, -30.0), B=(50.0, 0, -30.0), L0=49.9, EA=1e7, mass=8.0,
+                       weight=1.5 * RHO * G * area, elements=8, extra=extra,
+                       steps=static_step() + transient_step("free", 4.0, 0.05, rtol=1e-6,
+                                                            atol=1e-8, remove=["pull"]))
+    text = text.replace("weight = ", f"diameter = {d}\nweight = ")
+    ds = catdae.run(load_case(text), progress=False)["free"].to_dataset()
+    E, W = ds.energy_total.values, ds.energy_fluid_work.values
+    assert W[-1] < -100.0  # the water took a good part of the energy of the release
+    np.testing.assert_allclose(E - E[0], W, rtol=0, atol=1e-4 * abs(W[-1]))

@@ -554,6 +554,8 @@ HOSTILE = st.sampled_from([
     1e6, 1e300, -1e300, 1.7976931348623157e308, "", ".", "..", "$x", "a\x00b", "c.02", "main.0",
     "main.007", "main.99999", "/", "a/b", " ", "\t", "A", "main", "/etc/passwd", "/dev/zero",
     "../../etc/passwd", "é", "\u0301", "x" * 300, [], {}, [[]], [0.0] * 7, True,
+    # issue 24: names at and beyond the length limit, bidirectional controls
+    "x" * 100, "x" * 101, "n" * 100_000, "a\u202eb", "\u2067x", "b\u200f",
 ]).map(copy.deepcopy)  # fresh lists and tables: a mutation must not change the strategy
 
 

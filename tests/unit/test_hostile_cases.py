@@ -226,8 +226,8 @@ def test_a_mesh_node_with_a_leading_zero_is_refused(tmp_path, capsys):
 def test_a_transient_that_would_store_terabytes_is_refused(tmp_path, capsys):
     steps = static_step("st") + transient_step("dyn", 1e6, 1e-6, rtol=1e-6, atol=1e-8)
     invalid(scene(steps=steps), "steps[1].output_interval", "transient step 'dyn' would "
-            "store 1e+12 outputs of 5 nodes and 4 elements, 633 TiB, above the limit of 1 GiB "
-            "per step", tmp_path, capsys)
+            "store 1e+12 outputs of 5 nodes and 4 elements, 633 TiB, and need about 1.85 PiB of "
+            "memory with its working copies, above the limit of 1 GiB per step", tmp_path, capsys)
 
 
 def test_the_size_limit_is_judged_again_after_an_elements_override(tmp_path, capsys):

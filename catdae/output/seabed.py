@@ -1,0 +1,65 @@
+"""Seabed results of a static step (docs/case-format.md, "Seabed"): per cable, the unstrained
+length resting on the seabed and the touchdown point."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catdae._xr import xr
+from catdae.output.results import _label, _var
+
+
+def add_seabed(ds: xr.Dataset, mesh, summary: dict) -> xr.Dataset:
+    """``ds`` with ``seabed_length``(cable) and ``touchdown``(cable, axis)."""
+    if "cable" not in ds.coords:
+        ds = ds.assign_coords(cable=_label("cable", mesh.cable_names, "cable name"))
+    ds["seabed_length"] = _var("cable", summary["seabed_length"], "m",
+                               "unstrained length of cable resting on the seabed")
+    ds["touchdown"] = _var(("cable", "axis"), summary["touchdown"], "m",
+                           "touchdown point: where the cable leaves the seabed (NaN: none)")
+    return ds
+
+
+def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Dataset:
+    """A transient group with ``seabed_length``(time, cable) and ``touchdown``(time, cable,
+    axis) at node resolution, from the node positions: nodes at or below the seabed are in
+    contact; an element counts whole with both nodes in contact, half with one; the touchdown
+    is the last node in contact before the cable leaves the seabed, from its first end."""
+    if "position" not in ds or "time" not in ds.dims:
+        return ds
+    z = ds.position.sel(axis="z").transpose("time", "node").values  # (nt, n_nodes)
+    order = [list(ds.node.values).index(n) for n in mesh.node_names]
+    on = z[:, order] <= zb + 1e-9 * max(1.0, abs(zb))  # (nt, n_nodes) in mesh order
+    n_on = on[:, mesh.conn].sum(axis=2)  # (nt, n_elem)
+    nc = len(mesh.cable_names)
+    length = np.stack([(0.5 * n_on[:, mesh.cable_of_element == c] *
+                        mesh.L0[mesh.cable_of_element == c]).sum(axis=1) for c in range(nc)],
+                      axis=1)
+    pos = ds.position.transpose("time", "node", "axis").values[:, order]
+    td = np.full((z.shape[0], nc, 3), np.nan)
+    for c in range(nc):
+        els = np.flatnonzero(mesh.cable_of_element == c)
+        a, b = mesh.conn[els, 0], mesh.conn[els, 1]
+        for k in range(z.shape[0]):
+            if length[k, c] <= 0.0:
+                continue
+            leave = np.flatnonzero(on[k, a] != on[k, b])
+            if leave.size:
+                e = leave[0]
+                td[k, c] = pos[k, a[e]] if on[k, a[e]] else pos[k, b[e]]
+    if "cable" not in ds.coords:
+        ds = ds.assign_coords(cable=_label("cable", mesh.cable_names, "cable name"))
+    ds["seabed_length"] = _var(("time", "cable"), length, "m",
+                               "unstrained length of cable resting on the seabed")
+    ds["touchdown"] = _var(("time", "cable", "axis"), td, "m",
+                           "touchdown point: where the cable leaves the seabed (NaN: none)")
+    if contact is not None:  # the power the seabed's damping and friction take out, and its work
+        vel = ds.velocity.transpose("time", "node", "axis").values[:, order]
+        power = np.array([contact.dissipation(pos[k], vel[k]) for k in range(z.shape[0])])
+        t = ds.time.values
+        work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
+        ds["seabed_dissipation"] = _var("time", power, "W",
+                                        "power taken out by the seabed's damping and friction")
+        ds["seabed_work"] = _var("time", work, "J", "energy taken out by the seabed's damping "
+                                 "and friction since the step's start (trapezoidal rule)")
+    return ds

@@ -1,0 +1,175 @@
+"""Static equilibrium on a rigid, frictionless seabed (docs/theory.md §17.4).
+
+The nodes resting on the seabed are an active set: they are held at z_b (a roller in z) and
+the elements with an end on the seabed take their grounded relations (catdae.model.seabed,
+catdae.element.grounded). Newton (catdae.solvers.static) solves each set; then free nodes that
+went below z_b join the set and held nodes that the seabed would have to pull down leave it,
+until the set settles. With exact grounded elements the seabed's point forces at held nodes are
+zero at the solution (the seabed carries the lying weight along the elements), so the nodes
+are on the continuous grounded catenary, whatever the mesh.
+
+Start: each cable with exactly one end on the seabed, uniform properties and no loads inside
+is solved first as one grounded element spanning the cable (the closed-form grounded catenary)
+and its nodes are put on that curve; then Newton starts converged or nearly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from catdae.element import grounded as g
+from catdae.errors import ConvergenceError
+from catdae.model.assembly import Model
+from catdae.model.seabed import ContactModel, GroundedModel, SeabedContact
+from catdae.solvers.static import StaticSolution, solve_static
+
+
+def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
+                        load_steps: int = 1, max_rounds: int = 100
+                        ) -> tuple[StaticSolution, GroundedModel]:
+    """Equilibrium of ``model`` on a rigid frictionless seabed at height ``zb`` starting from
+    ``X`` (n_nodes, 3). Returns the solution and the GroundedModel of the final contact set
+    (whose tensions, reactions and positions are the grounded ones)."""
+    X = np.array(X, float, copy=True)
+    X.reshape(-1)[model.fixed] = model.support_positions(t)
+    scale = max(float(np.ptp(X, axis=0).max()), float(model.mesh.L0.sum()), 1.0)
+    ztol = 1e-9 * scale
+    fscale = max(float((model.mesh.w * model.mesh.L0).sum()), 1e-300)
+    fixed_z = model.fixed_mask[:, 2]
+    support_on = fixed_z & (np.abs(X[:, 2] - zb) <= ztol)
+    start = grounded_start(model, X, support_on)
+    try:
+        return _active_set(model, zb, start, h0, t, load_steps, max_rounds, ztol, fscale,
+                           support_on)
+    except ConvergenceError:
+        pass
+    # a first approach on stiff penalty springs (no grounded elements, no active set), whose
+    # equilibrium gives the active set nearly right: penetration w/k = 1e-4 element lengths
+    mesh = model.mesh
+    k = float(np.max(mesh.w / (1e-4 * mesh.L0)))
+    penalty = ContactModel(model, SeabedContact.of_model(model, stiffness=k,
+                                                         width=np.ones(mesh.n_elements)))
+    pre = solve_static(penalty, X, None, t=t, load_steps=load_steps)
+    return _active_set(model, zb, pre.X, None, t, load_steps, max_rounds, ztol, fscale,
+                       support_on)
+
+
+def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, support_on):
+    fixed_z = model.fixed_mask[:, 2]
+    contact = ~fixed_z & (X[:, 2] <= zb + ztol)
+    h = h0
+    seen: set[bytes] = set()
+    for _ in range(max_rounds):
+        X[contact, 2] = zb
+        gm = GroundedModel(model, contact, contact | support_on, zb)
+        sol = solve_static(gm, X, h, t=t, load_steps=load_steps)
+        X, h = sol.X, sol.state.h
+        r = gm.internal_force(sol.state, X) - gm.nodal_load(t)
+        if gm.fluid is not None:  # the fluid's static forces, as in the static residual
+            r = r + gm.fluid.static(X)[0]
+        rz = r.reshape(-1, 3)[:, 2]  # what the seabed must push up with at each node
+        below = ~fixed_z & ~contact & (X[:, 2] < zb - ztol)
+        pulling = contact & (rz < -1e-9 * fscale)
+        if not below.any() and not pulling.any():
+            _check_dips(gm, sol, zb, ztol)
+            return sol, gm
+        seen.add(contact.tobytes())
+        contact = (contact | below) & ~pulling
+        if contact.tobytes() in seen:
+            break
+    raise ConvergenceError("static step on the seabed: the set of nodes resting on the seabed "
+                           "does not settle")
+
+
+def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray) -> np.ndarray:
+    """Nodes of every cable with exactly one end supported on the seabed (uniform w and EA,
+    no loads inside) placed on the grounded catenary of the whole cable; others unchanged."""
+    mesh = model.mesh
+    el = model.elements
+    X = X.copy()
+    loaded = np.diff(el.loads.ptr) > 0
+    interior = np.zeros(mesh.n_nodes, bool)
+    for ci in range(len(mesh.cable_names)):
+        els = np.flatnonzero(mesh.cable_of_element == ci)
+        a, b = mesh.conn[els[0], 0], mesh.conn[els[-1], 1]
+        inner = mesh.conn[els[1:], 0]
+        interior[:] = False
+        interior[inner] = True
+        if (loaded[els].any() or on_support[a] == on_support[b] or np.ptp(el.w[els]) > 0
+                or np.ptp(el.EA[els]) > 0 or el.w[els[0]] <= 0
+                or model.fixed_mask[inner].any()):
+            continue
+        mode = g.AT_I if on_support[a] else g.AT_J
+        l0 = float(el.L0[els].sum())
+        w, ea = float(el.w[els[0]]), float(el.EA[els[0]])
+        h = np.zeros(3)
+        _, status = g.solve_grounded(X[b] - X[a], l0, ea, w, mode, h, False, 1e-13, 100,
+                                     np.zeros(6), np.zeros((3, 3)))
+        if status != g.CONVERGED:
+            continue
+        s = np.cumsum(el.L0[els])[None, :-1]
+        out = np.zeros((1, s.shape[1], 3))
+        g.position_batch(h[None], np.array([w]), np.array([ea]), np.array([l0]),
+                         np.array([mode]), s, out)
+        X[inner] = X[a] + out[0]
+    return X
+
+
+def _check_dips(gm: GroundedModel, sol, zb: float, ztol: float) -> None:
+    """A free element whose low point lies below the seabed between its nodes would need the
+    seabed inside it with both ends off it: not modelled, say so."""
+    free = np.flatnonzero(gm.mode == g.FREE)
+    if free.size == 0:
+        return
+    h = sol.state.h[free]
+    el = gm.base.elements
+    s_low = -h[:, 2] / np.where(el.w[free] > 0, el.w[free], np.inf)
+    inside = (s_low > 0) & (s_low < el.L0[free])
+    if not inside.any():
+        return
+    s = np.zeros((gm.mesh.n_elements, 1))
+    s[free[inside], 0] = s_low[inside]
+    z = sol.X[gm.mesh.conn[:, 0], 2] + el.position(sol.state.h, s)[:, 0, 2]
+    bad = free[inside][z[free[inside]] < zb - ztol]
+    if bad.size:
+        raise ConvergenceError(
+            f"element {gm.mesh.element_names[int(bad[0])]} dips below the seabed between its "
+            "nodes with both ends off it: use more elements on that cable, so that a node "
+            "falls on the lying part")
+
+
+def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str, np.ndarray]:
+    """Per cable: unstrained length resting on the seabed, and the touchdown point (where the
+    line leaves the seabed for the suspended part; NaN when it does not touch or does not
+    leave)."""
+    mesh = gm.mesh
+    nc = len(mesh.cable_names)
+    lying = gm.elements.lying_length(h)
+    length = np.bincount(mesh.cable_of_element, weights=lying, minlength=nc)
+    touchdown = np.full((nc, 3), np.nan)
+    el = gm.base.elements
+    for ci in range(nc):
+        els = np.flatnonzero(mesh.cable_of_element == ci)
+        if length[ci] <= 0.0:
+            continue
+        for e in els:
+            if gm.mode[e] in (g.AT_I, g.AT_J):
+                s = np.zeros((mesh.n_elements, 1))
+                s[e, 0] = np.clip(-h[e, 2] / el.w[e], 0.0, el.L0[e])
+                touchdown[ci] = X[mesh.conn[e, 0]] + gm.elements.position(h, s)[e, 0]
+                break
+    return {"seabed_length": length, "touchdown": touchdown}
+
+
+
+def solve_static_on_seabed(model: Model, X, h0=None, t: float = 0.0, load_steps: int = 1):
+    """A static step of a scene with a seabed: on the rigid seabed (no ``stiffness``, §17.4)
+    or on its contact springs (§17.5). Returns (solution, the model whose tensions and
+    reactions are the solution's, per-cable seabed_length and touchdown)."""
+    sb = model.case.seabed
+    if sb.stiffness is None:
+        sol, gm = solve_static_seabed(model, sb.z, X, h0, t=t, load_steps=load_steps)
+        return sol, gm, seabed_summary(gm, sol.X, sol.state.h)
+    contact = ContactModel(model, SeabedContact.of_model(model))
+    sol = solve_static(contact, X, h0, t=t, load_steps=load_steps)
+    return sol, contact, contact.summary(sol.X)

@@ -1,0 +1,220 @@
+"""MoorDyn's published validation scenes as catdae cases, and the comparisons its test programs
+make (tests/data/moordyn, BSD-3-Clause; the programs ``*.cpp`` there say how each is driven).
+
+Used by ``tests/scenes/test_moordyn_validation.py`` and ``benchmarks/moordyn_validation.py``.
+Nothing here is fitted to the reference curves: the inputs are MoorDyn's line files, the
+drive and the metrics its test programs.
+
+- The quasi-static chain (``chain_toml``): d 0.252 m, 390 kg/m, EA 1.674e9 N, Cd 1.37, Ca 1,
+  CdAx 0.64; seabed 1e5 Pa/m, 1e4 Pa s/m, friction 0.5 (rigid in the static tests); water
+  1025 kg/m³, its still level 5 m above the fairlead (MoorDyn's input puts it at the fairlead,
+  which the 2 m and 5 m heave records then lift out of the water: with catdae's buoyancy of
+  elements crossing the surface the run took three times the steps and came out noisy, 0.23
+  on the 2 m record against 0.088 with the line kept under water; the buoyancy of the at most
+  5 m of chain concerned is 2.6 kN of the ~2000 kN tension); the seabed stays at the given
+  depth. The fairlead at the origin heaves by the record ZZP1_A*; the case clock starts
+  at the record's t = -10 s. Metric: max |ΔT - ΔT_ref| / (2 max |ΔT_ref|) over the record's
+  t >= 0, ΔT the change of fairlead tension from each code's own static value (the reference's
+  static value is the published 2065.4 or 5232.6 kN), at most 0.15.
+- The Lowe & Langley (2006) jumper (``jumper_toml``): 170 m, d 0.396 m, 165 kg/m, EA 500 MN,
+  Cd 1, Ca 1 (EI = 120.8 kN m² is not modelled), from (-100, 0, -55) to (0, 0, -5) in 100 m
+  of fresh water, g = 9.807. Cases 2 and 3 move the top 10 m along y or z as
+  A f sin(2π t / 27 s), f the quintic smoothstep of t/27 over the first period; the top
+  tension magnitude is compared every 0.1 s over 80 s after the ramp with ``Case N.csv``.
+  Cases 4-6 hold the top in Airy waves 10 m high, period 10 s, from t = 0 (no ramp), with
+  phase and heading 230°/0°, 165°/45°, 0°/90°; compared over 30 s after two periods. (MoorDyn's
+  test gives the wave number of deep water with the finite-depth profile; catdae uses the
+  finite-depth dispersion: k differs by 0.07 % at this depth.)
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+DATA = Path(__file__).resolve().parent / "data" / "moordyn"
+CHAIN = {200: (700.0, 760.0, 2065.4, 1402.2), 600: (1500.0, 1700.0, 5232.6, 3244.2)}
+# the chain's still-water level: 5 m above the fairlead (see the module docstring)
+SURFACE = 5.0
+JUMPER_PERIOD = 27.0
+JUMPER_AMPLITUDE = 10.0
+WAVE_PERIOD = 10.0
+WAVE_CASES = {4: (230.0, 0.0), 5: (165.0, 45.0), 6: (0.0, 90.0)}  # phase, heading (deg)
+
+
+def read_table(path: Path, sep: str | None = None) -> np.ndarray:
+    rows = [line.replace(",", " ").split() for line in path.read_text().splitlines()
+            if line.strip()]
+    return np.array(rows, float)
+
+
+def _inline(t: np.ndarray, v: np.ndarray) -> str:
+    ts = ", ".join(f"{x:.6g}" for x in t)
+    vs = ", ".join(f"{x:.9g}" for x in v)
+    return f'{{ kind = "table", t = [{ts}], value = [{vs}] }}'
+
+
+def chain_toml(depth: int, *, elements: int = 20, motion: str | None = None,
+               rigid: bool = False, duration: float | None = None, rtol: float = 1e-4,
+               output_interval: float = 0.1, mass_model: str = "lumped",
+               max_order: str | int = "auto") -> str:
+    """The chain at ``depth`` (200 or 600 m). ``motion`` "ZZP1_A1" or "ZZP1_A2" adds the
+    fairlead heave record and a transient step of ``duration`` (default: the record)."""
+    x, length, _, _ = CHAIN[depth]
+    seabed = ("" if rigid else
+              "stiffness = 1.0e5\ndamping = 1.0e4\nfriction = 0.5\n")
+    text = f"""
+title = "MoorDyn/OrcaFlex quasi-static chain, {depth} m"
+gravity = 9.81
+[materials.chain]
+EA = 1.674e9
+mass = 390.0
+diameter = 0.252
+drag_normal = 1.37
+drag_axial = 0.64
+added_mass_normal = 1.0
+added_mass_axial = 0.0
+[water]
+density = 1025.0
+surface = {SURFACE!r}
+depth = {float(depth) + SURFACE!r}
+[seabed]
+z = {-float(depth)!r}
+{seabed}[nodes]
+anchor = [{x!r}, 0.0, {-float(depth)!r}]
+fairlead = [0.0, 0.0, 0.0]
+[supports]
+anchor = "pinned"
+fairlead = "pinned"
+[[cables]]
+name = "chain"
+ends = ["anchor", "fairlead"]
+material = "chain"
+length = {length!r}
+elements = {elements}
+[[steps]]
+kind = "static"
+name = "static"
+"""
+    if motion is not None:
+        rec = read_table(DATA / "quasi_static_chain" / f"{motion}.txt")
+        t = rec[:, 0] - rec[0, 0]
+        dur = float(t[-1]) if duration is None else duration
+        text += f"""[[support_motions]]
+node = "fairlead"
+z = {_inline(t, rec[:, 3])}
+[[steps]]
+kind = "transient"
+name = "heave"
+duration = {dur!r}
+output_interval = {output_interval!r}
+rtol = {rtol!r}
+atol = {rtol!r}
+mass_model = "{mass_model}"
+max_order = {max_order if isinstance(max_order, int) else repr(max_order).replace("'", '"')}
+"""
+    return text
+
+
+def chain_metric(times: np.ndarray, fair_tension: np.ndarray, depth: int, motion: str
+                 ) -> float:
+    """MoorDyn's dynamic metric for catdae's fairlead tension (N) sampled at ``times`` (case
+    clock, s): max |ΔT - ΔT_ref| / (2 max |ΔT_ref|) over the reference's rows."""
+    ref = read_table(DATA / "quasi_static_chain" / f"WD{depth:04d}_Chain_{motion}.txt")
+    ref = ref[ref[:, 0] + 10.0 <= times[-1] + 1e-9]  # rows the run reached
+    t_ref = ref[:, 0] + 10.0  # the record starts at -10 s, the case clock at 0
+    d_ref = 1e3 * ref[:, 3] - 1e3 * CHAIN[depth][2]
+    d_own = np.interp(t_ref, times, fair_tension) - fair_tension[0]
+    return float(np.max(np.abs(d_own - d_ref)) / (2.0 * np.max(np.abs(d_ref))))
+
+
+def jumper_motion(case: int, dt: float = 0.05, t_end: float | None = None):
+    """(t, displacement) of the top along y (case 2) or z (case 3)."""
+    T = JUMPER_PERIOD
+    t_end = T + 80.0 if t_end is None else t_end
+    t = np.arange(0.0, t_end + 1e-9, dt)
+    f = np.clip(t / T, 0.0, 1.0)
+    f = f**3 * (6 * f * f - 15 * f + 10)
+    return t, JUMPER_AMPLITUDE * f * np.sin(2 * math.pi * t / T)
+
+
+def jumper_toml(*, elements: int = 20, case: int | None = None, duration: float | None = None,
+                rtol: float = 1e-4, output_interval: float = 0.1, mass_model: str = "lumped",
+                max_order: str | int = "auto") -> str:
+    text = f"""
+title = "Lowe & Langley (2006) flexible jumper"
+gravity = 9.807
+[materials.jumper]
+EA = 500.0e6
+mass = 165.0
+diameter = 0.396
+drag_normal = 1.0
+drag_axial = 0.0
+added_mass_normal = 1.0
+added_mass_axial = 0.0
+[water]
+density = 1000.0
+surface = 0.0
+depth = 100.0
+[nodes]
+bottom = [-100.0, 0.0, -55.0]
+top = [0.0, 0.0, -5.0]
+[supports]
+bottom = "pinned"
+top = "pinned"
+[[cables]]
+name = "jumper"
+ends = ["bottom", "top"]
+material = "jumper"
+length = 170.0
+elements = {elements}
+[[steps]]
+kind = "static"
+name = "static"
+"""
+    if case in WAVE_CASES:  # Airy waves 10 m high, 10 s, from t = 0; the top held
+        phase, heading = WAVE_CASES[case]
+        dur = 2 * WAVE_PERIOD + 30.0 if duration is None else duration
+        text = text.replace("depth = 100.0\n", "depth = 100.0\nwaves = { kind = \"airy\", "
+                            f"height = 10.0, period = {WAVE_PERIOD!r}, heading = {heading!r}, "
+                            f"phase = {phase!r} }}\n")
+        text += f"""[[steps]]
+kind = "transient"
+name = "case{case}"
+duration = {dur!r}
+output_interval = {output_interval!r}
+rtol = {rtol!r}
+atol = {rtol!r}
+mass_model = "{mass_model}"
+max_order = {max_order if isinstance(max_order, int) else repr(max_order).replace("'", '"')}
+"""
+    elif case is not None:
+        dur = JUMPER_PERIOD + 80.0 if duration is None else duration
+        t, u = jumper_motion(case, t_end=dur + 1.0)
+        axis = {2: "y", 3: "z"}[case]
+        text += f"""[[support_motions]]
+node = "top"
+{axis} = {_inline(t, u)}
+[[steps]]
+kind = "transient"
+name = "case{case}"
+duration = {dur!r}
+output_interval = {output_interval!r}
+rtol = {rtol!r}
+atol = {rtol!r}
+mass_model = "{mass_model}"
+max_order = {max_order if isinstance(max_order, int) else repr(max_order).replace("'", '"')}
+"""
+    return text
+
+
+def jumper_error(times: np.ndarray, top_tension: np.ndarray, case: int) -> float:
+    """Largest |T - T_paper| (N) over the digitised curve (t after the one-period ramp, or
+    after two wave periods in cases 4-6)."""
+    ref = read_table(DATA / "lowe_and_langley_2006" / f"Case {case}.csv")
+    t = ref[:, 0] + (2 * WAVE_PERIOD if case in WAVE_CASES else JUMPER_PERIOD)
+    keep = t <= times[-1] + 1e-9
+    own = np.interp(t[keep], times, top_tension)
+    return float(np.max(np.abs(own - 1e3 * ref[keep, 1])))

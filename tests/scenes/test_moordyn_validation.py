@@ -1,0 +1,64 @@
+"""MoorDyn's published validation scenes (tests/moordyn_scenes.py, tests/data/moordyn):
+static tensions of the quasi-static chain against the quasi-static codes' values, and the
+Lowe & Langley jumper's static end forces. The dynamic comparisons with their costs are in
+benchmarks/moordyn_validation.py (a few of them, shortened, run here as slow tests)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from moordyn_scenes import CHAIN, chain_metric, chain_toml, jumper_error, jumper_toml
+
+import catdae
+from catdae.case import load_case
+
+
+def _run(text: str):
+    return catdae.run(load_case(text), progress=False)
+
+
+@pytest.mark.parametrize("depth", [200, 600])
+@pytest.mark.parametrize("rigid", [True, False])
+def test_chain_static_tensions(depth, rigid):
+    """Fairlead and anchor tensions within 0.5 % of 2065.4/1402.2 kN (200 m) and
+    5232.6/3244.2 kN (600 m) on the rigid seabed (exact grounded statics), within 1 % on
+    MoorDyn's contact springs (kBot 1e5 Pa/m: the chain sinks 0.13 m into the seabed); MoorDyn's
+    test allows 10 %."""
+    _, _, fair_kN, anchor_kN = CHAIN[depth]
+    ds = _run(chain_toml(depth, rigid=rigid))["static"].to_dataset()
+    fair = np.linalg.norm(ds.reaction.sel(node="fairlead").values) / 1e3
+    anch = np.linalg.norm(ds.reaction.sel(node="anchor").values) / 1e3
+    rel = 5e-3 if rigid else 1e-2
+    assert fair == pytest.approx(fair_kN, rel=rel)
+    assert anch == pytest.approx(anchor_kN, rel=rel)
+
+
+def test_jumper_static_end_forces():
+    """The top and bottom support forces, (11.40, 0, 45.71) and (-11.40, 0, 24.04) kN
+    within MoorDyn's 0.2 kN (the line without bending stiffness, submerged weight exact)."""
+    ds = _run(jumper_toml())["static"].to_dataset()
+    # MoorDyn's reference values are the supports' forces on the line: catdae's reactions
+    top = ds.reaction.sel(node="top").values / 1e3
+    bottom = ds.reaction.sel(node="bottom").values / 1e3
+    assert top == pytest.approx([11.40, 0.0, 45.71], abs=0.2)
+    assert bottom == pytest.approx([-11.40, 0.0, 24.04], abs=0.2)
+
+
+@pytest.mark.slow
+def test_chain_heave_against_orcaflex():
+    """The 200 m chain under the 2 m heave record (20 s compared after 10 s of lead-in), 20
+    elements, rtol 1e-3: within MoorDyn's dynamic tolerance 0.15 (MoorDyn: 0.07-0.12)."""
+    tree = _run(chain_toml(200, motion="ZZP1_A1", elements=20, rtol=1e-3))
+    ds = tree["heave"].to_dataset()
+    tension = np.linalg.norm(ds.reaction.sel(node="fairlead").values, axis=-1)
+    assert chain_metric(ds.time.values, tension, 200, "ZZP1_A1") <= 0.15
+
+
+@pytest.mark.slow
+def test_jumper_case2_shortened():
+    """Jumper case 2 (top sway along y), the first 30 s after the ramp, 40 elements: within
+    1.5 kN of the paper (MoorDyn with EI = 0: 0.35 kN over the whole case)."""
+    tree = _run(jumper_toml(case=2, duration=57.0, elements=40, rtol=1e-4))
+    ds = tree["case2"].to_dataset()
+    tension = np.linalg.norm(ds.reaction.sel(node="top").values, axis=-1)
+    assert jumper_error(ds.time.values, tension, 2) <= 1.5e3

@@ -1,0 +1,71 @@
+"""Bad ``[seabed]`` input: exit 2 with one located message (the file, the field, what was
+expected), through ``catdae check`` and ``catdae run`` (as tests/unit/test_hostile_cases.py)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from scene_toml import cable_scene, static_step, transient_step
+
+
+def invalid(text: str, field: str, expected: str, tmp_path, capsys, *,
+            subprocess_check: bool = True) -> None:
+    """``catdae check`` and ``catdae run`` refuse the case with exit 2 and the one line
+    ``catdae: invalid case: <file>: <field>: ...<expected>...``; nothing is written."""
+    from catdae.cli import main
+
+    f = tmp_path / "case.toml"
+    f.write_text(text)
+    want = f"catdae: invalid case: {f}: {field}: "
+    if subprocess_check:
+        proc = subprocess.run([sys.executable, "-m", "catdae", "check", str(f)], cwd=tmp_path,
+                              capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 2, proc.stderr
+        assert proc.stderr.startswith(want) and expected in proc.stderr, proc.stderr
+        assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    out = tmp_path / "out.nc"
+    for args in (["check", str(f)], ["run", str(f), "-o", str(out)]):
+        capsys.readouterr()
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(want) and expected in err, err
+        assert err.count("\n") == 1
+    assert not out.exists()
+
+
+def scene(seabed: str, steps: str | None = None, diameter: bool = True) -> str:
+    text = cable_scene(A=(0.0, 0.0, -20.0), B=(40.0, 0.0, -10.0), L0=60.0, EA=5e8, mass=80.0,
+                       elements=4, extra=f"[seabed]\n{seabed}\n",
+                       steps=static_step("st") if steps is None else steps)
+    if diameter:
+        text = text.replace("mass = 80.0\n", "mass = 80.0\ndiameter = 0.1\n")
+    return text
+
+
+@pytest.mark.parametrize("seabed, field, expected", [
+    ("z = -15.0", "seabed.z", "lies above support 'A'"),
+    ("z = -20.0\nstiffness = -1.0e5", "seabed.stiffness", "expected a value > 0"),
+    ("z = -20.0\nstiffness = 1e5\ndamping = -3.0", "seabed.damping",
+     "expected a value >= 0"),
+    ("z = -20.0\nfriction = -0.5", "seabed.friction", "Coulomb coefficient >= 0"),
+    ("z = -20.0\nfriction = { axial = 0.5 }", "seabed.friction.lateral", "required"),
+    ("z = -20.0\nfriction_velocity = 0.0", "seabed.friction_velocity", "expected a value > 0"),
+    ("stiffness = 1e5", "seabed.z", "give the height of the seabed"),
+    ("z = -20.0\nroughness = 2", "seabed.roughness", ""),
+])
+def test_bad_seabed_fields(seabed, field, expected, tmp_path, capsys):
+    invalid(scene(seabed), field, expected, tmp_path, capsys, subprocess_check=False)
+
+
+def test_a_rigid_seabed_refuses_a_transient_step(tmp_path, capsys):
+    steps = static_step("st") + transient_step("tr", 1.0, 0.1, rtol=1e-4, atol=1e-4)
+    invalid(scene("z = -20.0", steps), "steps[1]", "give [seabed] stiffness", tmp_path,
+            capsys, subprocess_check=False)
+
+
+def test_contact_stiffness_needs_a_diameter(tmp_path, capsys):
+    invalid(scene("z = -20.0\nstiffness = 1e5", diameter=False), "seabed.stiffness",
+            "need a diameter > 0", tmp_path, capsys)
