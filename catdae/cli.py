@@ -146,8 +146,9 @@ def _check(args) -> int:
 
 
 def _run(args) -> int:
-    from catdae.analysis import check_output, run
+    from catdae.analysis import run
     from catdae.case import load_case
+    from catdae.output.files import check_output
 
     path = Path(args.case) if args.case else default_case_path()
     case = load_case(path)

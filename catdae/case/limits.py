@@ -1,6 +1,6 @@
 """Limits judged before any work: what a case may ask for, and how files are read.
 
-Every number here is documented in docs/accuracy.md ("Limits") and case-format.md. A case
+Every number here is documented in docs/case-format.md ("Limits"). A case
 that exceeds one is refused by ``catdae check`` and ``catdae run`` (exit 2) with the field and
 the limit, instead of failing deep inside a solver (a segfault in the sparse solver at 10⁶
 elements, a 7 TiB allocation after the static step) or hanging on a file that never ends.
