@@ -6,9 +6,10 @@ no damping (``--duration`` sets the simulated time; default 10 s).
 
 OpenSees (openseespy) models it with ``element CatenaryCable`` (Abell & Ibanez; exact elastic
 catenary flexibility, Newton on the misclosure each update) and integrates with Newmark's
-average-acceleration rule (γ = 1/2, β = 1/4) at a fixed dt. CatenaryCable's mass is lumped
-(massType 0: ρ L0 / 2 at each end; its other types are either truss-consistent or not
-implemented), so the comparison uses catdae with ``mass_model = "lumped"`` too: the same
+average-acceleration rule (γ = 1/2, β = 1/4) at a fixed dt. CatenaryCable's mass is lumped here
+(massType 0: ρ L0 / 2 at each end; the worker takes ``mass_type`` 1, truss-consistent, from
+its job, as ``opensees_head_to_head.py`` uses it), so the comparison uses catdae with
+``mass_model = "lumped"`` too: the same
 semi-discrete model, integrated by IDA (variable order/step BDF) or by Newmark. The OpenSees
 nodes start at catdae's static equilibrium (the exact catenary); a static Newton step in
 OpenSees confirms it is in equilibrium there too.
@@ -79,7 +80,8 @@ def worker() -> None:
         ops.fix(node + 1, *[0 if (node == moving and d == axis) else 1 for d in (1, 2, 3)])
     for e, (i, j) in enumerate(conn):
         ops.element("CatenaryCable", e + 1, i + 1, j + 1, job["weight"], job["EA"], 1.0,
-                    job["L0e"][e], 0.0, 0.0, job["rho"], job["error_tol"], job.get("nsub", 1), 0)
+                    job["L0e"][e], 0.0, 0.0, job["rho"], job["error_tol"], job.get("nsub", 1),
+                    job.get("mass_type", 0))
     # support motion: z_A(t) = 0.5 (1 - cos πt), sampled exactly at the steps
     nsteps = int(round(duration / dt))
     values = [amp * (1.0 - math.cos(math.pi * k * dt)) for k in range(nsteps + 2)]
