@@ -69,4 +69,37 @@ def _install() -> bool:
     return True
 
 
+def _install_scheduler_probe() -> bool:
+    """Answer xarray's question "which dask scheduler is active?" (asked by every netCDF write
+    and file lock) without importing dask.distributed when it cannot be the answer.
+
+    xarray's ``get_dask_scheduler`` asks dask, which imports ``distributed`` (about 0.1-0.15 s
+    of CPU in every ``catdae run``) to see whether a distributed Client is active. A Client can
+    only exist if ``distributed`` has been imported, and with no scheduler configured dask then
+    falls back to its default, for which xarray answers "threaded". Only that case is answered
+    here; any other (distributed imported, a scheduler configured, a collection given) goes to
+    xarray's own function."""
+    try:
+        from xarray.backends import locks, writers
+    except ImportError:  # pragma: no cover - another xarray layout: keep its own probe
+        return False
+    real = getattr(locks, "get_dask_scheduler", None)
+    if real is None or getattr(writers, "get_dask_scheduler", None) is not real:
+        return False
+
+    def get_dask_scheduler(get=None, collection=None):
+        if get is None and collection is None and "distributed" not in sys.modules:
+            try:
+                import dask.config
+            except ImportError:
+                return real(get, collection)
+            if dask.config.get("scheduler", None) is None and dask.config.get("get", None) is None:
+                return "threaded"
+        return real(get, collection)
+
+    locks.get_dask_scheduler = writers.get_dask_scheduler = get_dask_scheduler
+    return True
+
+
 INSTALLED = _install()
+SCHEDULER_PROBE = _install_scheduler_probe()
