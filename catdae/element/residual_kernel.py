@@ -6,6 +6,12 @@ Python between the compiled kernels as in them on meshes of tens of elements
 (benchmarks/speed_accuracy.md §7). ``residual_pass`` does all of it in one call and leaves the
 element state (tensions, flexibilities, stiffnesses, masses, ∂M/∂c) in the caller's buffers,
 where the iteration matrix and the outputs find it.
+
+The element work is written out here rather than through ``mass._dynamics_one``: a call
+between compiled functions with some forty array arguments cost about 0.6 µs per element
+(more than a warm element solve), so the pass calls the solve and the mass kernels directly
+and skips the mass entirely for a lumped or constant mass (benchmarks/cheaper_steps.md; the
+residuals are bit-identical).
 """
 
 from __future__ import annotations
@@ -13,8 +19,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import NOT_CONVERGED
-from catdae.element.mass import _dynamic_forces, _dynamics_one, _dynamics_work
+from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, _solve_one
+from catdae.element.mass import _dynamic_forces, _dynamics_work, _mass_one
+from catdae.element.mass_gradient import _gradient_fade, _mass_grad_one
 
 
 @njit(cache=True)
@@ -55,9 +62,33 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         for a in range(3):
             chord[a] = X[j + a] - X[i + a]
             hw[e, a] = h[e, a]
-        _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, hw, use_h, tol, max_iter, gs, gw, mq,
-                      cq, pmptr, pms, pmm, want_m, want_c, want_dm, fflat, kmat, its, stat, me,
-                      ce, dm, xw, g6, fg, dkk, gm, bm, fm, nm, dn)
+        if not want_m:  # a lumped or constant mass: the solve alone
+            its[e], stat[e] = _solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+                                         hw[e], use_h, tol, max_iter, fflat[e], kmat[e])
+        else:
+            its[e], stat[e] = _solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+                                         hw[e], use_h, tol, max_iter, fflat[e], kmat[e])
+            if stat[e] == NOT_CONVERGED:
+                return False
+            k0, k1 = ptr[e], ptr[e + 1]
+            done = False
+            if want_dm:
+                fade = 0.0
+                if stat[e] == CONVERGED:
+                    fade = _gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
+                if fade > 0.0:
+                    done = _mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
+                                          gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
+                                          fade, me[e], dm[e], g6, fg, dkk, gm, bm, nm, dn, fm)
+                if not done:
+                    dm[e, :, :, :] = 0.0
+            slack = stat[e] == SLACK
+            if not done:
+                _mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
+                          gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, me[e], xw, g6)
+            if want_c:
+                _mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
+                          gw[e], cq[e], 0, 0, pms, pmm, False, ce[e], xw, g6)
         if stat[e] == NOT_CONVERGED:
             return False
         for a in range(3):
