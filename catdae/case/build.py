@@ -136,7 +136,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         ground = self.ground(top.ground, self.gravity_direction)
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
-        self.fluid_lines(top.materials, water, air)
+        self.fluid_lines(top.materials)
         seabed = self.seabed(top.seabed, nodes, supports, materials, steps,
                              water_floor=None if water is None or not math.isfinite(water.depth)
                              else water.surface - water.depth)

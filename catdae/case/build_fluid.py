@@ -10,6 +10,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, Field
 
 from catdae.case.fluid import Air, Current, Water, Waves, Wind
+from catdae.case.frame import gravity_rotation
 from catdae.case.messages import _found
 from catdae.case.schema import _STRICT, _VEC3, NonNeg, Pos, TomlTable, Vec3
 
@@ -155,8 +156,12 @@ class _FluidPass:
             self.problem(where + ("roughness",), f"expected a roughness length below the "
                          f"reference_height {p.reference_height:g} m, found {p.roughness:g}")
             return None
+        # towards ``direction`` in the plane normal to gravity, from the gravity frame's first
+        # axis towards its second (global x and y with gravity along -z; catdae.case.frame)
         th = math.radians(p.direction)
-        vec = (p.speed * math.cos(th), p.speed * math.sin(th), 0.0)
+        e1, e2, _ = gravity_rotation(self.gravity_direction)
+        vec = tuple(float(p.speed * (math.cos(th) * a + math.sin(th) * b))
+                    for a, b in zip(e1, e2, strict=True))
         return Wind(p.profile, vec, float(p.exponent or p.roughness or 0.0),
                     float(p.reference_height), p.ground, tf)
 
@@ -206,9 +211,8 @@ class _FluidPass:
         return Current(tuple(float(x) for x in z),
                        tuple(tuple(float(x) for x in u) for u in vel), tf)
 
-    def fluid_lines(self, materials_raw: dict, water: Water | None, air: Air | None) -> None:
-        """Fluid coefficients need a diameter; waves need a water depth; no fluid with a
-        gravity vector off -z."""
+    def fluid_lines(self, materials_raw: dict) -> None:
+        """Fluid coefficients need a diameter."""
         for key, item in materials_raw.items():
             if not isinstance(item, dict) or item.get("diameter") is not None:
                 continue
@@ -216,8 +220,3 @@ class _FluidPass:
                 if f in item:
                     self.problem(("materials", key, f), f"{f} needs the line's diameter "
                                  "(add diameter = ... in m)")
-        if (water is not None or air is not None) and \
-                self.gravity_direction != (0.0, 0.0, -1.0):
-            self.problem(("water",) if water is not None else ("air",),
-                         "water and air need gravity along -z (a number for gravity); a "
-                         "gravity vector is not supported with fluids")
