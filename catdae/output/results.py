@@ -18,6 +18,7 @@ import numpy as np
 from catdae._version import __version__
 from catdae._xr import xr
 from catdae.model.mesh import AXES, Mesh
+from catdae.output.environment import environment_attrs
 from catdae.output.files import INCOMPLETE_SUFFIX, clean_stale, incomplete_name  # noqa: F401
 
 CONVENTIONS = "CF-1.10"
@@ -170,7 +171,9 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     """Root with provenance and one group per step, in step order.
 
     Every group also has ``Conventions``, ``history`` and a ``title``, so that a group written
-    as a file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them.
+    as a file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them, and
+    in water or on a seabed ``up``, ``water_surface``, ``water_depth``, ``seabed_z``
+    (catdae.output.environment).
     """
     created = datetime.now(UTC).isoformat(timespec="seconds")
     history = f"{created} catdae {__version__}: run of case {case.name!r} ({status})"
@@ -185,8 +188,9 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
         "Conventions": CONVENTIONS,
         "history": history,
     }))
+    env = environment_attrs(case)  # the water surface and seabed (figures, the VTK export)
     groups = {k: v.assign_attrs(Conventions=CONVENTIONS, history=history,
-                                title=f"{case.title or case.name}: step {k}")
+                                title=f"{case.title or case.name}: step {k}", **env)
               for k, v in groups.items()}
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 

@@ -50,7 +50,8 @@ def water_scene(Q, rigid: bool = False) -> str:
     seabed (statics only) the current is zero at the bed: the exact grounded elements take no
     drag while resting (docs/case-format.md, "Seabed")."""
     off = heading_offset(Q)
-    cur = [vec(Q @ np.array(u)) for u in ([0.0, 0.0, 0.0] if rigid else [0.2, 0.1, 0.0], [0.6, 0.3, 0.0])]
+    bottom = [0.0, 0.0, 0.0] if rigid else [0.2, 0.1, 0.0]
+    cur = [vec(Q @ np.array(u)) for u in (bottom, [0.6, 0.3, 0.0])]
     bed = "" if rigid else "stiffness = 1.0e6\ndamping = 1.0e3\nfriction = 0.3\n"
     extra = (
         "[water]\nsurface = 0.0\ndepth = 50.0\n"
