@@ -280,15 +280,17 @@ class Fluid:
         z = np.zeros(np.size(X))
         return self.evaluate(t, X, z, z, waves=False)[1]
 
-    def kinematics(self, points: np.ndarray, t: float):
+    def kinematics(self, points: np.ndarray, t: float, waves: bool = True):
         """Surface elevation above the still level at the points' (x, y), (n,) m, and the fluid
-        velocity at the points (water below the surface, air above), (n, 3) m/s."""
-        cf, af, r, dr = self._factors(t, True)
+        velocity at the points (water below the surface, air above), (n, 3) m/s; without
+        ``waves`` in still water (as static and modal steps see it)."""
+        cf, af, r, dr = self._factors(t, waves)
         pts = np.ascontiguousarray(points, float).reshape(-1, 3)
         eta = np.zeros(pts.shape[0])
         vel = np.zeros((pts.shape[0], 3))
         point_kinematics(pts, float(t), self.rho_w, self.surface, self.depth, self.c_kind,
-                         self.c_vec, self.c_z, self.c_v, cf, *self.wave, r, dr, self.rho_a,
+                         self.c_vec, self.c_z, self.c_v, cf,
+                         *(self.wave if waves else (_EMPTY,) * 6), r, dr, self.rho_a,
                          self.a_kind, self.a_vec, self.a_speed, self.a_dir, self.a_expo,
                          self.a_zref, self.a_ground, af, eta, vel)
         return eta, vel

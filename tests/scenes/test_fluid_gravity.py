@@ -95,7 +95,8 @@ def test_turned_scene_in_water_air_and_on_a_seabed_is_the_turned_answer(upright,
     turned = catdae.run(catdae.load_case(water_scene(Q)))
     s0, s1 = upright["s"].ds, turned["s"].ds
     assert float(s0.seabed_length.values[0]) > 10.0  # the chain does rest on the seabed
-    for var in ("position", "reaction", "tension", "seabed_length", "touchdown"):
+    for var in ("position", "reaction", "tension", "seabed_length", "touchdown",
+                "fluid_velocity"):
         _close(s1[var], s0[var], Q, 1e-9)
     f0, f1 = upright["m"].ds.frequency.values, turned["m"].ds.frequency.values
     assert f1 == pytest.approx(f0, rel=1e-9)
@@ -116,3 +117,28 @@ def test_turned_chain_on_a_rigid_seabed_in_current_is_the_turned_answer(turn):
     assert float(a.seabed_length.values[0]) > 10.0
     for var in ("position", "reaction", "tension", "seabed_length", "touchdown"):
         _close(b[var], a[var], Q, 1e-9)
+
+
+def test_static_fluid_velocity_is_the_current_profile_and_the_wind_law(upright):
+    # below the surface the profile, linear in z between (-50, [0.2, 0.1, 0]) and (0, [0.6,
+    # 0.3, 0]), constant below -50 (nodes sunk into the contact springs); above the surface
+    # 20 (h / 10)^0.12 m/s towards 60 deg
+    ds = upright["s"].ds
+    x = ds.position.values
+    want = np.zeros_like(x)
+    wet = x[:, 2] <= 0.0
+    f = np.clip((x[wet, 2] + 50.0) / 50.0, 0.0, 1.0)
+    want[wet] = np.outer(1 - f, [0.2, 0.1, 0.0]) + np.outer(f, [0.6, 0.3, 0.0])
+    b = math.radians(60.0)
+    want[~wet] = np.outer(20.0 * (x[~wet, 2] / 10.0) ** 0.12, [math.cos(b), math.sin(b), 0.0])
+    assert (~wet).sum() == 1 and wet.sum() == 10
+    np.testing.assert_allclose(ds.fluid_velocity.values, want, rtol=1e-12, atol=1e-14)
+
+
+def test_rigid_seabed_in_a_current_at_its_height_is_refused_plainly():
+    # a frictionless rigid seabed cannot hold the drag on the line resting on it
+    text = water_scene(np.eye(3), rigid=True).replace("[[0.0, 0.0, 0.0], [0.6", "[[0.05, 0.0, "
+                                                                                "0.0], [0.6")
+    with pytest.raises(catdae.errors.ConvergenceError, match="rests on the rigid seabed in a "
+                       "current of 0.05 m/s"):
+        catdae.run(catdae.load_case(text), progress=False)

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from scene_toml import cable_scene, static_step, transient_step
+from scene_toml import cable_scene, raw, static_step, transient_step
 
 
 def invalid(text: str, field: str, expected: str, tmp_path, capsys, *,
@@ -69,3 +69,16 @@ def test_a_rigid_seabed_refuses_a_transient_step(tmp_path, capsys):
 def test_contact_stiffness_needs_a_diameter(tmp_path, capsys):
     invalid(scene("z = -20.0\nstiffness = 1e5", diameter=False), "seabed.stiffness",
             "need a diameter > 0", tmp_path, capsys)
+
+
+@pytest.mark.parametrize("extra", ["[seabed]\nz = -15.0\n",
+                                   "[water]\ndepth = 15.0\n[seabed]\nstiffness = 1e5\n"])
+def test_a_seabed_above_an_anchor_along_a_gravity_vector(extra, tmp_path, capsys):
+    # gravity along -x: heights are x; anchor A at height -20 lies below a seabed at -15 (given
+    # as z, or as the water's surface - depth)
+    text = cable_scene(A=(-20.0, 0.0, 0.0), B=(-10.0, 0.0, 40.0), L0=60.0, EA=5e8, mass=80.0,
+                       elements=4, gravity=raw("[-9.81, 0.0, 0.0]"), extra=extra,
+                       steps=static_step("st")).replace("mass = 80.0\n",
+                                                        "mass = 80.0\ndiameter = 0.1\n")
+    invalid(text, "seabed.z", "lies above support 'A' (z = -20 m)", tmp_path, capsys,
+            subprocess_check=False)
