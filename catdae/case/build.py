@@ -139,7 +139,8 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         self.fluid_lines(top.materials)
         seabed = self.seabed(top.seabed, nodes, supports, materials, steps,
                              water_floor=None if water is None or not math.isfinite(water.depth)
-                             else water.surface - water.depth)
+                             else water.surface - water.depth,
+                             water_surface=None if water is None else water.surface)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)

@@ -101,6 +101,9 @@ class _FluidPass:
             kind, w = self.kinded(v.waves, where + ("waves",), _WAVE_MODELS, "wave kind")
             if kind is not None:
                 waves = Waves(kind=kind, **w.model_dump(exclude={"kind"}))
+            if kind is not None and not self.gravity > 0.0:
+                self.problem(where + ("waves",), "waves need gravity > 0 (their dispersion "
+                             f"ω² = g k tanh(k h)), found gravity = {self.gravity:g} m/s²")
         if not complete:
             return None
         depth = math.inf if v.depth is None else float(v.depth)

@@ -36,7 +36,8 @@ class _SeabedPass:
     """Mixin of the case builder (catdae.case.build._Builder)."""
 
     def seabed(self, raw: dict | None, nodes: dict, supports: dict, materials: dict,
-               steps: list, water_floor: float | None = None) -> Seabed | None:
+               steps: list, water_floor: float | None = None,
+               water_surface: float | None = None) -> Seabed | None:
         if raw is None:
             return None
         where = ("seabed",)
@@ -71,6 +72,10 @@ class _SeabedPass:
                 self.problem(where + ("z",), f"the seabed at z = {z:g} m lies above support "
                              f"{name!r} (z = {self._height(p):g} m): supports must be on or "
                              "above the seabed")
+        if water_surface is not None and z > water_surface:
+            self.problem(where + ("z",), f"the seabed at z = {z:g} m lies above the still-water "
+                         f"level [water] surface = {water_surface:g} m: expected a seabed under "
+                         "the water (for dry ground leave out [water])")
         if sb.stiffness is None:
             for i, st in enumerate(steps):
                 if st.kind in ("modal", "transient"):
