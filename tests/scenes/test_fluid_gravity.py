@@ -72,7 +72,7 @@ def water_scene(Q, rigid: bool = False) -> str:
                  extra=extra, steps=steps)
 
 
-TURNS = {"x-up": rotation([0.0, 1.0, 0.0], -np.pi / 2),  # gravity along -x
+TURNS = {"g+x": rotation([0.0, 1.0, 0.0], -np.pi / 2),  # gravity along +x
          "oblique": rotation([1.0, 2.0, 0.5], 0.7)}
 
 
