@@ -1,5 +1,5 @@
 """Pass 3 for the fluids around the cables: ``[water]`` and ``[air]`` (docs/case-format.md,
-"Water and air"). A mixin of :class:`~catdae.case.build._Builder`, whose ``problem``,
+"Water and air"). A mixin of :class:`~catdae.case.build.Builder`, whose ``problem``,
 ``validate`` and ``time_function`` collect what is wrong."""
 
 from __future__ import annotations
@@ -11,14 +11,14 @@ from pydantic import BaseModel, Field
 
 from catdae.case.fluid import Air, Current, Water, Waves, Wind
 from catdae.case.frame import gravity_rotation
-from catdae.case.messages import _found
-from catdae.case.schema import _STRICT, _VEC3, NonNeg, Pos, TomlTable, Vec3
+from catdae.case.messages import found_text
+from catdae.case.schema import STRICT, VEC3, NonNeg, Pos, TomlTable, Vec3
 
 _Angle = Annotated[float, Field(ge=-360.0, le=360.0)]
 
 
 class _Water(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     density: Pos = 1025.0
     surface: float = 0.0
     depth: Pos | None = None
@@ -27,26 +27,26 @@ class _Water(BaseModel):
 
 
 class _Air(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     density: Pos = 1.225
     wind: Any = None  # a vector, or a profile table: checked by the builder
 
 
 class _Profile(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     z: Annotated[list[float], Field(min_length=1)]
     velocity: Annotated[list[Vec3], Field(min_length=1)]
     time: TomlTable | None = None
 
 
 class _UniformFlow(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     velocity: Vec3
     time: TomlTable | None = None
 
 
 class _WindProfile(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     speed: NonNeg
     direction: _Angle = 0.0
     profile: Literal["power", "log", "uniform"] = "uniform"
@@ -58,7 +58,7 @@ class _WindProfile(BaseModel):
 
 
 class _Airy(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["airy"]
     height: Pos
     period: Pos
@@ -68,7 +68,7 @@ class _Airy(BaseModel):
 
 
 class _Jonswap(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["jonswap"]
     hs: Pos
     tp: Pos
@@ -82,7 +82,7 @@ class _Jonswap(BaseModel):
 _WAVE_MODELS: dict[str, type[BaseModel]] = {"airy": _Airy, "jonswap": _Jonswap}
 
 
-class _FluidPass:
+class FluidPass:
     """``[water]`` and ``[air]`` (methods of ``_Builder``)."""
 
     def water(self, raw: dict | None) -> Water | None:
@@ -90,7 +90,7 @@ class _FluidPass:
             return None
         where = ("water",)
         if not isinstance(raw, dict):
-            self.problem(where, f"expected a table [water], found {_found(raw)}")
+            self.problem(where, f"expected a table [water], found {found_text(raw)}")
             return None
         v, complete = self.validate(_Water, raw, where)
         if v is None:
@@ -114,7 +114,7 @@ class _FluidPass:
             return None
         where = ("air",)
         if not isinstance(raw, dict):
-            self.problem(where, f"expected a table [air], found {_found(raw)}")
+            self.problem(where, f"expected a table [air], found {found_text(raw)}")
             return None
         if "waves" in raw:
             self.problem(where + ("waves",), "waves belong to [water]: there are no waves in "
@@ -175,18 +175,18 @@ class _FluidPass:
             return None
         if isinstance(raw, list):
             try:
-                vec = _VEC3.validate_python(raw)
+                vec = VEC3.validate_python(raw)
             except Exception:  # noqa: BLE001 - reported below
                 vec = None
             if vec is None:
                 self.problem(where, f"expected a velocity [ux, uy, uz] of 3 finite numbers "
-                             f"(m/s), found {_found(raw)}")
+                             f"(m/s), found {found_text(raw)}")
                 return None
             return Current((), (tuple(float(x) for x in vec),), None)
         if not isinstance(raw, dict):
             self.problem(where, "expected a velocity [ux, uy, uz] (m/s) or a table "
                          + ("{ z = [...], velocity = [[ux, uy, uz], ...] }" if profile else
-                            "{ speed, direction, profile, ... }") + f", found {_found(raw)}")
+                            "{ speed, direction, profile, ... }") + f", found {found_text(raw)}")
             return None
         if "z" in raw and profile:
             v, ok = self.validate(_Profile, raw, where)

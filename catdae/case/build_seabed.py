@@ -11,7 +11,7 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from catdae.case.messages import _found, _is_number
+from catdae.case.messages import found_text, is_number
 from catdae.case.model import Seabed
 
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
@@ -32,8 +32,8 @@ class _Seabed(BaseModel):
     friction_velocity: Annotated[float, Field(gt=0)] = 0.01
 
 
-class _SeabedPass:
-    """Mixin of the case builder (catdae.case.build._Builder)."""
+class SeabedPass:
+    """Mixin of the case builder (catdae.case.build.Builder)."""
 
     def seabed(self, raw: dict | None, nodes: dict, supports: dict, materials: dict,
                steps: list, water_floor: float | None = None,
@@ -42,14 +42,14 @@ class _SeabedPass:
             return None
         where = ("seabed",)
         if not isinstance(raw, dict):
-            self.problem(where, f"expected a table [seabed], found {_found(raw)}")
+            self.problem(where, f"expected a table [seabed], found {found_text(raw)}")
             return None
         sb, complete = self.validate(_Seabed, raw, where)
         if sb is None:
             return None
         axial = lateral = 0.0
         fr = sb.friction
-        if _is_number(fr) and not isinstance(fr, bool) and fr >= 0:
+        if is_number(fr) and not isinstance(fr, bool) and fr >= 0:
             axial = lateral = float(fr)
         elif isinstance(fr, dict):
             f, ok = self.validate(_Friction, fr, where + ("friction",))
@@ -59,7 +59,7 @@ class _SeabedPass:
                 axial, lateral = f.axial, f.lateral
         else:
             self.problem(where + ("friction",), "expected a Coulomb coefficient >= 0 or a "
-                         f"table {{ axial = .., lateral = .. }}, found {_found(fr)}")
+                         f"table {{ axial = .., lateral = .. }}, found {found_text(fr)}")
             complete = False
         z = sb.z if sb.z is not None else water_floor
         if z is None:

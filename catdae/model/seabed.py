@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from catdae.element import grounded as g
-from catdae.element.elements import ElementState, _sym_from_upper
+from catdae.element.elements import ElementState, sym_from_upper
 from catdae.errors import ConvergenceError
 from catdae.model.assembly import Model
 
@@ -165,7 +165,7 @@ class GroundedModel(Model):
             b = self.base.elements
             g.solve_batch(np.ascontiguousarray(self.chords(X)), b.L0, b.EA, b.w, self.mode,
                           idx, h, h0 is not None, 1e-13, 100, fflat, K, its, stat)
-            F[idx] = _sym_from_upper(fflat[idx])
+            F[idx] = sym_from_upper(fflat[idx])
         b = self.base.elements
         v0 = h[:, 2]
         v1 = v0 + b.w * b.L0

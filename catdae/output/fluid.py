@@ -8,7 +8,7 @@ import numpy as np
 from catdae._xr import xr
 from catdae.element.fluid_kinematics import NONE
 from catdae.model.fluid import Fluid
-from catdae.output.results import _var
+from catdae.output.results import var
 
 
 def with_fluid(ds: xr.Dataset, fluid: Fluid, times: np.ndarray, X: np.ndarray) -> xr.Dataset:
@@ -22,10 +22,10 @@ def with_fluid(ds: xr.Dataset, fluid: Fluid, times: np.ndarray, X: np.ndarray) -
     out = ds.copy()
     if fluid.water is not None:
         out.attrs["water_surface"] = float(fluid.surface)  # m, z of the still-water level
-    out["fluid_velocity"] = _var(("time", "node", "axis"), vel, "m/s",
+    out["fluid_velocity"] = var(("time", "node", "axis"), vel, "m/s",
                                  "velocity of the water (below the surface) or the air at the node")
     if fluid.waves is not None:
-        out["surface_elevation"] = _var(("time", "node"), eta, "m",
+        out["surface_elevation"] = var(("time", "node"), eta, "m",
                                          "elevation of the water surface above the still-water "
                                          "level at the node's (x, y)")
     return out
@@ -39,6 +39,6 @@ def with_static_fluid(ds: xr.Dataset, fluid: Fluid | None, X: np.ndarray, t: flo
         return ds
     vel = fluid.kinematics(np.asarray(X, float).reshape(-1, 3), float(t), waves=False)[1]
     out = ds.copy()
-    out["fluid_velocity"] = _var(("node", "axis"), vel, "m/s", "velocity of the still water "
+    out["fluid_velocity"] = var(("node", "axis"), vel, "m/s", "velocity of the still water "
                                  "(below the surface) or the air at the node")
     return out

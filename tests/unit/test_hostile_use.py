@@ -801,3 +801,15 @@ def test_fuzz_foreign_result_files(data, three_kinds, tmp_path, capsys):
         err = capsys.readouterr().err
         assert code in (0, 2), (how, err)
         assert "Traceback" not in err and (code == 0) == (err == ""), (how, err)
+
+
+@pytest.mark.parametrize("x", [1e300, -2e7, 1.7976931348623157e308])
+def test_a_node_beyond_the_coordinate_limit_is_refused_by_name(tmp_path, capsys, x):
+    """A node at 1e300 m once overflowed inside form-finding (found by the fuzzer): node
+    coordinates are limited to ±1e7 m (docs/case-format.md, Limits), judged with the field."""
+    case = tmp_path / "far.toml"
+    case.write_text(scene(B=(x, 0.0, 0.0), L0=10.5))
+    refused(here(capsys, "check", case), "far.toml", "nodes.B[0]", "10000000")
+    inside = tmp_path / "inside.toml"  # the limit itself is a valid coordinate
+    inside.write_text(scene(A=(1e7 - 10.0, 0.0, 0.0), B=(1e7, 0.0, 0.0), L0=10.5))
+    assert here(capsys, "check", inside).returncode == 0
