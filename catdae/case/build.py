@@ -150,6 +150,7 @@ class Builder(CablesPass, ConnectorsPass, StepsPass, SweepPass, TimePass, FluidP
                              water_floor=None if water is None or not math.isfinite(water.depth)
                              else water.surface - water.depth,
                              water_surface=None if water is None else water.surface)
+        self.water_floor(water, nodes, supports, seabed)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)

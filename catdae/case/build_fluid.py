@@ -223,3 +223,22 @@ class FluidPass:
                 if f in item:
                     self.problem(("materials", key, f), f"{f} needs the line's diameter "
                                  "(add diameter = ... in m)")
+
+    def water_floor(self, water: Water | None, nodes: dict, supports: dict, seabed) -> None:
+        """With waves over a finite depth, the wave kinematics hold down to the floor at
+        surface - depth only: no support and no seabed below it."""
+        if water is None or water.waves is None or not math.isfinite(water.depth):
+            return
+        floor = water.surface - water.depth
+        tol = 1e-9 * max(1.0, abs(floor))
+        if seabed is not None and seabed.z < floor - tol:
+            self.problem(("seabed", "z"), f"the seabed at z = {seabed.z:g} m lies below the "
+                         f"water's floor surface - depth = {floor:g} m, where the waves' "
+                         "kinematics end: expected a [water] depth reaching the seabed")
+        for name in supports:
+            p = nodes.get(name)
+            if p is not None and self.height(p) < floor - tol:
+                self.problem(("water", "depth"), f"support {name!r} (z = {self.height(p):g} "
+                             f"m) lies below the water's floor surface - depth = {floor:g} m, "
+                             "where the waves' kinematics end: expected a depth reaching it")
+

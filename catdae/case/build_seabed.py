@@ -68,9 +68,9 @@ class SeabedPass:
             return None
         for name in supports:
             p = nodes.get(name)
-            if p is not None and self._height(p) < z - 1e-9 * max(1.0, abs(z)):
+            if p is not None and self.height(p) < z - 1e-9 * max(1.0, abs(z)):
                 self.problem(where + ("z",), f"the seabed at z = {z:g} m lies above support "
-                             f"{name!r} (z = {self._height(p):g} m): supports must be on or "
+                             f"{name!r} (z = {self.height(p):g} m): supports must be on or "
                              "above the seabed")
         if water_surface is not None and z > water_surface:
             self.problem(where + ("z",), f"the seabed at z = {z:g} m lies above the still-water "
@@ -94,7 +94,7 @@ class SeabedPass:
                       friction_axial=axial, friction_lateral=lateral,
                       friction_velocity=sb.friction_velocity)
 
-    def _height(self, p) -> float:
+    def height(self, p) -> float:
         """Height of a point along "up" (-gravity)."""
         g = self.gravity_direction
         return -(p[0] * g[0] + p[1] * g[1] + p[2] * g[2])

@@ -39,6 +39,10 @@ WATER = "[water]\ndepth = 100.0\n"
      "waves need gravity > 0"),
     (BASE + "[water]\nsurface = -60.0\n[seabed]\nz = -55.0\n", "seabed.z",
      "lies above the still-water level"),
+    (BASE + '[water]\ndepth = 40.0\nwaves = { kind = "airy", height = 1.0, period = 5.0 }\n',
+     "water.depth", "support 'A' (z = -50 m) lies below the water's floor"),
+    (BASE + WATER + 'waves = { kind = "airy", height = 1.0, period = 5.0 }\n[seabed]\n'
+     "z = -120.0\n", "seabed.z", "lies below the water's floor surface - depth = -100 m"),
 ])
 def test_bad_fluid_input_is_located_with_exit_2(text, field, expected, tmp_path):
     f = tmp_path / "case.toml"
