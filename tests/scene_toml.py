@@ -7,7 +7,7 @@ A to node B.
     title, gravity, head                 (each only when given; ``head``: further top-level keys)
     [materials.<material>]  EA, mass, weight, properties (weight and properties only when given;
                             ``properties``: further fields of the material, e.g. diameter)
-    [nodes]                 A, B
+    [nodes]                 A, B, nodes (further nodes, only when given)
     [supports]              one ``<name> = "pinned"`` line per entry of ``supports``
     [[cables]]              name, ends = ["A", "B"], material, length, elements, gauss_points
     extra                   verbatim (loads, point masses, support motions, ...)
@@ -28,7 +28,8 @@ Scenes of several cables, or with other node names, are written by ``scene`` in 
 ``extra`` and ``steps``); ``cable_scene`` is ``scene`` with one cable from A to B. The blocks of
 the arrays of tables are written by ``table`` (one ``key = value`` line per field given, in the
 order given, ``None`` left out) and its named forms ``cable``, ``point_mass``, ``load``,
-``distributed_load``, ``support_motion`` and ``step``; a plain table (``[seabed]``,
+``distributed_load``, ``support_motion``, ``spring``, ``damper``, ``bar`` and ``step``; a plain
+table (``[seabed]``,
 ``[ground]``, ...) by ``section``. Values: a bool as ``true``/``false``, an
 integer as such, any other number as ``num`` writes it, a string quoted (``raw(...)`` as it
 stands), a sequence as an array and a mapping as an inline table.
@@ -118,6 +119,21 @@ def support_motion(node: str, **axes) -> str:
     return table("support_motions", node=node, **axes)
 
 
+def spring(name: str, ends, stiffness, **more) -> str:
+    """A ``[[springs]]`` block (``more``: length, ...)."""
+    return table("springs", name=name, ends=list(ends), stiffness=stiffness, **more)
+
+
+def damper(name: str, ends, coefficient, **more) -> str:
+    """A ``[[dampers]]`` block."""
+    return table("dampers", name=name, ends=list(ends), coefficient=coefficient, **more)
+
+
+def bar(name: str, ends, EA, **more) -> str:
+    """A ``[[bars]]`` block (``more``: mass, length, ...)."""
+    return table("bars", name=name, ends=list(ends), EA=EA, **more)
+
+
 def step(kind: str, /, name: str | None = None, **fields) -> str:
     """A ``[[steps]]`` block of any kind (``name`` left out when ``None``)."""
     return table("steps", kind=kind, name=name, **fields)
@@ -145,6 +161,7 @@ def cable_scene(*, B, L0, EA, mass, elements: int | None = None, A=(0.0, 0.0, 0.
                 weight=None, gauss_points: int | None = None,
                 supports: Sequence[str] = ("A", "B"), title: str | None = None, gravity=None,
                 head: Mapping | None = None, properties: Mapping | None = None,
+                nodes: Mapping[str, Sequence] | None = None,
                 material: str = "m", cable: str = "c", extra: str = "", steps: str = "",
                 num: Callable[[object], str] = _float) -> str:
     """One cable from node A to node B, as TOML text (see the module docstring for the layout)."""
@@ -158,7 +175,8 @@ def cable_scene(*, B, L0, EA, mass, elements: int | None = None, A=(0.0, 0.0, 0.
     return scene(head={"title": title, "gravity": n(gravity), **(head or {})},
                  materials={material: {"EA": n(EA), "mass": n(mass), "weight": n(weight),
                                        **(properties or {})}},
-                 nodes={"A": n(A), "B": n(B)}, supports=supports,
+                 nodes={"A": n(A), "B": n(B), **{k: n(x) for k, x in (nodes or {}).items()}},
+                 supports=supports,
                  cables=_cable(cable, ("A", "B"), material, n(L0), elements,
                                gauss_points=gauss_points),
                  extra=extra, steps=steps, num=num)
