@@ -1,6 +1,6 @@
 """A real ``python -m catdae`` process and signals sent to it once it shows that it runs (shared
-by tests/unit/test_interrupts.py and tests/scenes/test_extremes.py): no fixed sleeps, generous
-timeouts."""
+by tests/unit/test_interrupts.py, tests/unit/test_hostile_use.py and
+tests/scenes/test_extremes.py): no fixed sleeps, generous timeouts."""
 
 from __future__ import annotations
 

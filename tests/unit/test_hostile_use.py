@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -30,6 +29,7 @@ import catdae
 import catdae.output.results
 from catdae.cli import main
 
+from processes import catdae_process, signal_when, transient_runs
 from scene_toml import cable_scene, long_transient, modal_step, static_step, transient_step
 
 PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
@@ -483,53 +483,11 @@ def test_plot_functions_raise_plot_error(three_kinds, tmp_path):
 
 
 # -- 16. SIGHUP -----------------------------------------------------------------------------------
-def run_until(proc, ready, timeout=180.0):
-    """Read the process's stderr in a thread until ``ready(text so far)`` holds; returns the
-    chunks read and the thread (reading on)."""
-    chunks: list[bytes] = []
-
-    def read_err():
-        while b := proc.stderr.read1(4096):
-            chunks.append(b)
-
-    reader = threading.Thread(target=read_err, daemon=True)
-    reader.start()
-    deadline = time.monotonic() + timeout
-    while not ready(b"".join(chunks).decode(errors="replace")):
-        assert proc.poll() is None, b"".join(chunks).decode(errors="replace")
-        assert time.monotonic() < deadline, b"".join(chunks).decode(errors="replace")
-        time.sleep(0.05)
-    return chunks, reader
-
-
-def stop(proc, sig, chunks, reader) -> tuple[int, str]:
-    """Send ``sig``; return (exit code, all of stderr)."""
-    proc.send_signal(sig)
-    try:
-        code = proc.wait(120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    reader.join(30)
-    proc.stderr.close()
-    return code, b"".join(chunks).decode(errors="replace")
-
-
-def transient_runs(err: str) -> bool:
-    """The progress bar of the transient step shows that it has passed t = 1 s."""
-    shown = re.findall(r"dyn:.*?t=([0-9.]+)/", err)
-    return bool(shown) and float(shown[-1]) > 1.0
-
-
 def test_sighup_stops_a_run_like_sigterm(tmp_path):
     case = long_case(tmp_path / "long.toml")
     out = tmp_path / "long.nc"
-    proc = subprocess.Popen([sys.executable, "-m", "catdae", "run", str(case), "-o", str(out),
-                             "--progress"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            cwd=tmp_path, env=dict(os.environ, PYTHONUNBUFFERED="1"))
-    chunks, reader = run_until(proc, transient_runs)
-    code, err = stop(proc, signal.SIGHUP, chunks, reader)
+    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], tmp_path)
+    code, err = signal_when(proc, signal.SIGHUP, transient_runs)
     assert code == 129, err
     assert "Traceback" not in err and "catdae: interrupted by SIGHUP" in err
     tree = catdae.read_results(out)
