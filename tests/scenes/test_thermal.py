@@ -21,18 +21,7 @@ import catdae
 from catdae.errors import CaseError
 
 from reference import level_catenary_midspan
-from scene_toml import (
-    cable,
-    cable_scene,
-    distributed_load,
-    load,
-    modal_step,
-    point_mass,
-    scene,
-    static_step,
-    step,
-    transient_step,
-)
+from scene_toml import cable, cable_scene, distributed_load, load, point_mass, scene, step
 
 # code_aster V6.02.114 (SSNL114): 2 l0 = 2 L = 325 m, A = 2.2783e-4 m², E = 5.7e10 Pa,
 # α = 2.3e-5 /K, ρ = 2844.23 kg/m³, g = 9.81; heated from 0 to 39.26 °C
@@ -46,7 +35,7 @@ def ssnl114_text(elements=10):
     return cable_scene(
         B=(p["L"], 0.0, 0.0), L0=p["L"], EA=EA, mass=m, elements=elements,
         properties={"thermal_expansion": p["alpha"]},
-        steps=static_step("cold") + step("static", "hot", temperature_change=p["dT"]))
+        steps=step("static", "cold") + step("static", "hot", temperature_change=p["dT"]))
 
 
 def test_ssnl114_heavy_cable_heated():
@@ -118,8 +107,9 @@ def test_weightless_taut_bar_and_per_cable_temperature():
 def test_temperature_holds_in_the_modal_and_transient_steps_that_follow():
     # a taut string: f_k = k/(2 l) sqrt(T l / (m L0)) with T = EA (l/L0 - 1 - α ΔT)
     l, L0, EA, m, alpha, dT = 10.0, 9.99, 1e6, 0.2, 2e-5, 25.0
-    steps = (step("static", "hot", temperature_change=dT) + modal_step(2)
-             + transient_step("rest", 0.05, 0.01, rtol=1e-8, atol=1e-10))
+    steps = (step("static", "hot", temperature_change=dT) + step("modal", "modes", modes=2)
+             + step("transient", "rest", duration=0.05, output_interval=0.01, rtol=1e-8,
+                    atol=1e-10))
     text = cable_scene(B=(l, 0.0, 0.0), L0=L0, EA=EA, mass=m, weight=0.0, elements=40,
                        properties={"thermal_expansion": alpha}, steps=steps)
     tree = catdae.run(catdae.load_case(text))
