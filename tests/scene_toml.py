@@ -4,21 +4,22 @@ A to node B.
 
 ``cable_scene`` writes, in this order and without blank lines::
 
-    title, gravity, head                 (each only when given; ``head``: further top-level keys)
-    [materials.<material>]  EA, mass, weight, properties (weight and properties only when given;
+    title, gravity, head    (each only when given; ``head``: further top-level keys)
+    [materials.<material>]  EA, mass, weight, properties (weight only when given;
                             ``properties``: further fields of the material, e.g. diameter)
-    [nodes]                 A, B, nodes (further nodes, only when given)
+    [nodes]                 A, B, nodes (``nodes``: further nodes, e.g. a ground node)
     [supports]              one ``<name> = "pinned"`` line per entry of ``supports``
     [[cables]]              name, ends = ["A", "B"], material, length, elements, gauss_points
     extra                   verbatim (loads, point masses, support motions, ...)
     steps                   verbatim
 
-Numbers are written with ``num`` (by default ``repr(float(x))``: a TOML float, also for numpy
-scalars; a number given as a string, e.g. ``"4.696e8"``, is written as it stands; a sequence,
-e.g. a gravity vector, as an array of such numbers).
-``elements`` and ``gauss_points`` are written as integers and left out when ``None``. ``extra``
-and ``steps`` get a closing newline if they lack one. A string in ``supports`` that already
-holds ``=`` (e.g. ``'B = ["y", "z"]'``) is written as it stands.
+The numbers of the nodes, EA, mass, weight, length and gravity are written with ``num`` (by
+default ``repr(float(x))``: a TOML float, also for numpy scalars; a number given as a string,
+e.g. ``"4.696e8"``, is written as it stands; a sequence, e.g. a gravity vector, as an array of
+such numbers). ``elements`` and ``gauss_points`` are written as integers and left out when
+``None``; ``head`` and ``properties`` values as ``value`` writes them (below). ``extra`` and
+``steps`` get a closing newline if they lack one. A string in ``supports`` that already holds
+``=`` (e.g. ``'B = ["y", "z"]'``) is written as it stands.
 
 ``static_step``, ``modal_step`` and ``transient_step`` give the ``[[steps]]`` blocks most scenes
 end with.
@@ -29,10 +30,9 @@ Scenes of several cables, or with other node names, are written by ``scene`` in 
 the arrays of tables are written by ``table`` (one ``key = value`` line per field given, in the
 order given, ``None`` left out) and its named forms ``cable``, ``point_mass``, ``load``,
 ``distributed_load``, ``support_motion``, ``spring``, ``damper``, ``bar`` and ``step``; a plain
-table (``[seabed]``,
-``[ground]``, ...) by ``section``. Values: a bool as ``true``/``false``, an
-integer as such, any other number as ``num`` writes it, a string quoted (``raw(...)`` as it
-stands), a sequence as an array and a mapping as an inline table.
+table (``[seabed]``, ``[ground]``, ...) by ``section``. Values (``value``): a bool as
+``true``/``false``, an integer as such, any other number as ``num`` writes it, a string quoted
+(``raw(...)`` as it stands), a sequence as an array and a mapping as an inline table.
 
 Shared scenes: ``long_transient`` (a transient that is always interrupted before its end) and
 ``falling_mass`` (a mass dropped onto a slack rope: the snap).
