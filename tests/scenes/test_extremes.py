@@ -23,7 +23,6 @@ import math
 import signal
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -34,7 +33,7 @@ import catdae.analysis
 from catdae.cli import main
 
 import scene_toml
-from processes import catdae_process, signal_when, transient_runs
+from processes import interrupted_run, long_case
 from reference import (
     irvine_catenary,
     irvine_catenary_inclined_3d,
@@ -42,7 +41,7 @@ from reference import (
     taut_string_frequencies,
 )
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, load, long_transient, modal_step, static_step, transient_step
+from scene_toml import cable_scene, load, modal_step, static_step
 
 G = 9.81
 
@@ -65,8 +64,10 @@ def modal(n: int) -> str:
     return modal_step(n)
 
 
-def transient(duration, dt, *, rtol=1e-8, atol=1e-10, remove=()) -> str:
-    return transient_step("dyn", duration, dt, rtol=rtol, atol=atol, remove=list(remove))
+def transient(duration, dt, *, rtol=1e-8, atol=1e-10, remove=(), mass_model=None) -> str:
+    return scene_toml.step("transient", "dyn", remove=list(remove), duration=float(duration),
+                           output_interval=float(dt), rtol=float(rtol), atol=float(atol),
+                           mass_model=mass_model)
 
 
 def point_mass(name, s, m) -> str:
@@ -301,7 +302,7 @@ def test_point_load_100_times_the_weight_is_two_catenaries_in_equilibrium():
 # vertical: the plumb line
 # ------------------------------------------------------------------------------------------------
 PLUMB_L, PLUMB_M, PLUMB_m = 20.0, 100.0, 1e-3
-BOB = '[[point_masses]]\nname = "bob"\nnode = "B"\nmass = 100.0\n'
+BOB = scene_toml.point_mass("bob", PLUMB_M, node="B")
 
 
 def plumb(zB, ne=4, xB=0.0):
@@ -329,8 +330,7 @@ def _check_plumb(tree, ne):
     np.testing.assert_allclose(f, pendulum, rtol=1e-3)
 
 
-SHAKE_TOP = ('[[support_motions]]\nnode = "A"\n'
-             'x = { kind = "sine", amplitude = 0.2, frequency = 0.5 }\n')
+SHAKE_TOP = scene_toml.support_motion("A", x={"kind": "sine", "amplitude": 0.2, "frequency": 0.5})
 
 
 @pytest.mark.xfail(strict=True, reason=(
@@ -385,8 +385,7 @@ def _shaken_chain(mass_model):
     """A chain hanging free, its top shaken sideways for 1 s: the sideways disturbance needs
     2 sqrt(L/g) = 2.86 s to reach the free end, which must not move sideways yet; the
     work-energy theorem ΔE = ∫ R·v_A dt must hold."""
-    steps = STATIC + transient(1.0, 0.002, rtol=1e-6, atol=1e-8).replace(
-        'kind = "transient"', f'kind = "transient"\nmass_model = "{mass_model}"')
+    steps = STATIC + transient(1.0, 0.002, rtol=1e-6, atol=1e-8, mass_model=mass_model)
     text = scene(B=(0.0, 0.0, -20.02), L0=20.0, EA=1e7, mass=1.0, elements=10, supports=("A",),
                  extra=SHAKE_TOP, steps=steps)
     ds = catdae.run(text)["dyn"].to_dataset()
@@ -782,11 +781,6 @@ def test_bad_input_through_python_m_catdae(tmp_path, command):
 # ------------------------------------------------------------------------------------------------
 # nothing lost: interruptions
 # ------------------------------------------------------------------------------------------------
-def _long_case(path: Path, duration=1000.0) -> Path:
-    path.write_text(long_transient(duration))
-    return path
-
-
 def test_interrupted_transient_in_process_keeps_results(tmp_path, monkeypatch, capsys):
     """KeyboardInterrupt inside IDA after 30 steps: exit 130, the earlier output file is kept,
     the partial results go to <stem>.failed.nc with a status that says why."""
@@ -804,7 +798,7 @@ def test_interrupted_transient_in_process_keeps_results(tmp_path, monkeypatch, c
             return super().step(*args, **kwargs)
 
     monkeypatch.setattr(transient, "IDA", Interrupting)
-    case = _long_case(tmp_path / "long.toml")
+    case = long_case(tmp_path / "long.toml")
     out = tmp_path / "long.nc"
     out.write_bytes(b"previous results")
     code = main(["run", str(case), "-o", str(out), "--no-progress"])
@@ -842,11 +836,9 @@ def test_interrupted_modal_step_keeps_the_static_results(tmp_path, monkeypatch, 
 
 def test_sigint_during_a_long_transient(tmp_path):
     """A real Ctrl-C (SIGINT) to ``python -m catdae run`` while the transient runs."""
-    case = _long_case(tmp_path / "long.toml")
     out = tmp_path / "long.nc"
     out.write_bytes(b"previous results")
-    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], tmp_path)
-    code, err = signal_when(proc, signal.SIGINT, transient_runs)
+    code, err, _ = interrupted_run(tmp_path, signal.SIGINT, out)
     assert code == 130, err
     assert "Traceback" not in err
     assert "catdae: interrupted by SIGINT" in err
