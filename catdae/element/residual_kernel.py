@@ -7,7 +7,7 @@ Python between the compiled kernels as in them on meshes of tens of elements
 element state (tensions, flexibilities, stiffnesses, masses, ∂M/∂c) in the caller's buffers,
 where the iteration matrix and the outputs find it.
 
-The element work is written out here rather than through ``mass._dynamics_one``: a call
+The element work is written out here rather than through ``mass.dynamics_one``: a call
 between compiled functions with some forty array arguments cost about 0.6 µs per element
 (more than a warm element solve), so the pass calls the solve and the mass kernels directly
 and skips the mass entirely for a lumped or constant mass (benchmarks/cheaper_steps.md; the
@@ -19,9 +19,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, _solve_one
-from catdae.element.mass import _dynamic_forces, _dynamics_work, _mass_one
-from catdae.element.mass_gradient import _gradient_fade, _mass_grad_one
+from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, solve_one
+from catdae.element.mass import dynamic_forces, dynamics_work, mass_one
+from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 
 
 @njit(cache=True)
@@ -53,7 +53,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         X[d] = xp[k]
         V[d] = vp[k]
         A[d] = ap[k]
-    xw, g6, fg, dkk, gm, bm, fm, nm, dn = _dynamics_work()
+    xw, g6, fg, dkk, gm, bm, fm, nm, dn = dynamics_work()
     chord = np.empty(3)
     ne = conn.shape[0]
     for e in range(ne):
@@ -63,10 +63,10 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
             chord[a] = X[j + a] - X[i + a]
             hw[e, a] = h[e, a]
         if not want_m:  # a lumped or constant mass: the solve alone
-            its[e], stat[e] = _solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+            its[e], stat[e] = solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
                                          hw[e], use_h, tol, max_iter, fflat[e], kmat[e])
         else:
-            its[e], stat[e] = _solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
+            its[e], stat[e] = solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
                                          hw[e], use_h, tol, max_iter, fflat[e], kmat[e])
             if stat[e] == NOT_CONVERGED:
                 return False
@@ -75,19 +75,19 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
             if want_dm:
                 fade = 0.0
                 if stat[e] == CONVERGED:
-                    fade = _gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
+                    fade = gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
                 if fade > 0.0:
-                    done = _mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
+                    done = mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
                                           gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
                                           fade, me[e], dm[e], g6, fg, dkk, gm, bm, nm, dn, fm)
                 if not done:
                     dm[e, :, :, :] = 0.0
             slack = stat[e] == SLACK
             if not done:
-                _mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
+                mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
                           gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, me[e], xw, g6)
             if want_c:
-                _mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
+                mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
                           gw[e], cq[e], 0, 0, pms, pmm, False, ce[e], xw, g6)
         if stat[e] == NOT_CONVERGED:
             return False
@@ -108,7 +108,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                     for r in range(6):
                         for c in range(6):
                             dm[e, kk, r, c] *= scale
-    _dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm, want_dm, alpha,
+    dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm, want_dm, alpha,
                     beta, V, A, force)
     for k in range(n):
         d = fidx[k]
