@@ -42,6 +42,7 @@ class _State:
         self.X = X  # (n_nodes, 3) m
         self.V = np.zeros_like(X)  # (n_nodes, 3) m/s
         self.h: np.ndarray | None = None  # (n_elem, 3) N, warm start
+        self.snap = ""  # the step that took the lumped mass for a snap (auto), if the last
         self.t = 0.0
 
 
@@ -206,8 +207,11 @@ def step_model(case: Case, mesh, absent: set[str], step: Step, state: _State) ->
     model = Model(case, mesh, absent, mass_model=step.mass_model, kind=step.kind)
     if step.kind == "transient" and step.mass_model == "auto" and model.mass_model.catenary:
         reason = snap_reason(model, step, state.X, state.V, state.t, state.h)
+        if not reason and state.snap and np.any(state.V):  # its wave is still travelling
+            reason = f"it continues step '{state.snap}', which took it for a snap"
         if reason:
             model = Model(case, mesh, absent, mass_model="auto", kind=step.kind, snap=reason)
+    state.snap = step.name if model.mass_model.snap else ""
     return model
 
 

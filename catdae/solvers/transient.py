@@ -23,6 +23,7 @@ from sksundae.ida import IDA
 
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.snap import velocity_jumps
 from catdae.progress import reporter
 from catdae.solvers.order import (
     OrderChoice,
@@ -99,6 +100,7 @@ class _Run:
         self.dt_out = float(step.output_interval)
         self.times = output_times(self.t0, float(step.duration), self.dt_out)
         self.y0, self.yp0 = prob.initial(self.t0, state.X, state.V)
+        self.V_start = state.V
         self._ida_options()
         self.outputs = OutputRecord(prob, self.times)
         self.n_steps = self.n_restarts = 0
@@ -111,8 +113,9 @@ class _Run:
         step, prob, t0, y0 = self.step, self.prob, self.t0, self.y0
         self.linsolver = choose_solver(prob, step.linear_solver)
         self.omega = _reference_frequency(prob, t0, y0)
+        jumps = velocity_jumps(self.model, self.V_start, t0, self.t_end)
         self.resolve, self.resolve_choice = resolve_mode(
-            step.resolve, self.model.mass_model.carries_axial_waves)
+            step.resolve, self.model.mass_model.carries_axial_waves, bool(jumps))
         atol, self.omega_error = error_weights(self.resolve, step.atol, self.omega,
                                                self.dt_out, prob.n)
         self.auto = step.max_order == "auto"
