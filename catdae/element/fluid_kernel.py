@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.fluid_kinematics import _profile, surface_elevation, wave_kinematics
+from catdae.element.fluid_kinematics import profile, surface_elevation, wave_kinematics
 
 
 @njit(cache=True)
@@ -147,7 +147,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
             wet = rho_w > 0.0 and xg[2] <= surface + eta
             if wet:
                 rho = rho_w
-                _profile(c_kind, xg[2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur, du)
+                profile(c_kind, xg[2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur, du)
                 if has_waves:
                     for a in range(3):
                         uf[a] += c_fac * ur[a]
@@ -160,7 +160,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                         gu[a, 2] = c_fac * du[a]
             elif rho_a > 0.0:
                 rho = rho_a
-                _profile(a_kind, xg[2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
+                profile(a_kind, xg[2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
                          a_ground, uf, du)
                 for a in range(3):
                     uf[a] *= a_fac
