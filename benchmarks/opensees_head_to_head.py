@@ -17,8 +17,8 @@ integration") is not implemented in the element: it prints a warning and falls b
 mass (this script checks that its history equals massType 0's). 2 is a lumped mass split by the
 end forces.
 
-1. Search: catdae in-process (CPU of ``catdae.run``) over mesh × rtol × mass model
-   (``max_order = "auto"``); OpenSees as processes over mesh × dt for each mass type.
+1. Search: catdae in-process (CPU of ``catdae.run``) over mesh × rtol × mass model × the step's
+   ``resolve`` (``max_order = "auto"``); OpenSees as processes over mesh × dt for each mass type.
 2. Head-to-head: for each target (1 cm, 2 mm) the cheapest runs of the search that reach it
    (two of catdae's, two of each OpenSees mass type) are run again as whole processes,
    ``python -m catdae run CASE -o OUT.nc`` (imports, kernels, static step, transient, netCDF) and
@@ -37,6 +37,7 @@ import statistics
 import sys
 import tempfile
 import time
+import tomllib
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -49,6 +50,7 @@ sys.path.insert(0, str(HERE))
 import speed_accuracy as sa  # noqa: E402
 
 import catdae  # noqa: E402
+from catdae.case import case_from_dict  # noqa: E402
 
 TARGETS = (1e-2, 2e-3)  # m
 OPS_TYPES = {0: "lumped", 3: "truss-consistent"}
@@ -62,22 +64,34 @@ def load() -> float:
 
 
 # ---------------------------------------------------------------------------- runs
-def catdae_inproc(n: int, rtol: float, mass: str, order="auto") -> dict:
+def case_text(n: int, rtol: float, mass: str, order="auto", resolve="auto") -> str:
+    """speed_accuracy's case with the step's ``resolve`` (docs/case-format.md) when not auto."""
+    text = sa.case_text(n, rtol, mass_model=mass, max_order=order)
+    if resolve != "auto":
+        text = text.replace(f'mass_model = "{mass}"',
+                            f'mass_model = "{mass}"\nresolve = "{resolve}"')
+    return text
+
+
+def catdae_inproc(n: int, rtol: float, mass: str, order="auto", resolve="auto") -> dict:
     t0 = time.process_time()
-    r = sa.run_catdae(n, rtol, mass_model=mass, max_order=order)
+    tree = catdae.run(case_from_dict(tomllib.loads(case_text(n, rtol, mass, order, resolve))),
+                      progress=False)
     cpu = time.process_time() - t0
-    ds = r.pop("tree")["motion"].ds
+    ds = tree["motion"].ds
     return {"code": "catdae", "ne": n, "rtol": rtol, "mass": mass, "order": order,
-            "cpu": cpu, "z": r["z"], "steps": r["steps"],
+            "resolve": resolve, "cpu": cpu,
+            "z": ds.position.sel(node=f"c.{n // 2}", axis="z").values,
+            "steps": int(ds.attrs["n_steps"]),
             "res": int(ds.attrs["n_residual_evaluations"]),
-            "jac": int(ds.attrs["n_jacobian_evaluations"]), "final_order": r["order"]}
+            "jac": int(ds.attrs["n_jacobian_evaluations"]),
+            "final_order": ds.attrs["max_order"]}
 
 
 def catdae_process(c: dict, folder: Path) -> dict:
     """``python -m catdae run`` in a new process: wall, CPU and the midspan history."""
-    path = folder / f"case_{c['ne']}_{c['rtol']:g}_{c['mass']}.toml"
-    path.write_text(sa.case_text(c["ne"], c["rtol"], mass_model=c["mass"],
-                                 max_order=c["order"]))
+    path = folder / f"case_{c['ne']}_{c['rtol']:g}_{c['mass']}_{c['resolve']}.toml"
+    path.write_text(case_text(c["ne"], c["rtol"], c["mass"], c["order"], c["resolve"]))
     out = folder / f"out_{time.time_ns()}.nc"
     argv = [sys.executable, "-m", "catdae", "run", str(path), "-o", str(out), "--no-progress"]
     p, wall, cpu = sa.children_cost(sa.subprocess.run, argv, capture_output=True, text=True)
@@ -127,16 +141,16 @@ def search_catdae(zref, args) -> list[dict]:
     meshes = [int(x) for x in args.meshes.split(",")]
     tols = [float(x) for x in args.tols.split(",")]
     rows = []
-    for mass in masses:
+    for mass, resolve in ((m, v) for m in masses for v in args.resolve.split(",")):
         for n in meshes:
             best = None
             for rtol in tols:  # loosest first
-                r = catdae_inproc(n, rtol, mass)
+                r = catdae_inproc(n, rtol, mass, resolve=resolve)
                 r["err"] = sa.err(r["z"], zref)
                 rows.append(r)
-                print(f"catdae {mass:14s} {n:4d} el rtol {rtol:.0e}: err {r['err']:.2e} m, "
-                      f"CPU {r['cpu']:.2f} s, {r['steps']} steps, {r['res']} residuals, "
-                      f"order {r['final_order']}", flush=True)
+                print(f"catdae {mass} {resolve:6s} {n:4d} el rtol {rtol:.0e}: err "
+                      f"{r['err']:.2e} m, CPU {r['cpu']:.2f} s, {r['steps']} steps, "
+                      f"{r['res']} residuals, order {r['final_order']}", flush=True)
                 if best is not None and r["err"] > 0.8 * best:
                     break  # the mesh's own error: a tighter rtol buys nothing
                 best = r["err"] if best is None else min(best, r["err"])
@@ -230,7 +244,8 @@ def head_to_head(crows, orows, env, args) -> list[dict]:
 
 def label(r: dict) -> str:
     if r["code"] == "catdae":
-        return f"catdae {r['mass']}, {r['ne']} el, rtol {r['rtol']:.0e}"
+        res = "" if r.get("resolve", "auto") == "auto" else f", resolve {r['resolve']}"
+        return f"catdae {r['mass']}{res}, {r['ne']} el, rtol {r['rtol']:.0e}"
     return f"OpenSees massType {r['mass_type']} ({OPS_TYPES.get(r['mass_type'], '?')}), " \
            f"{r['ne']} el, dt {r['dt']:g} s"
 
@@ -309,7 +324,9 @@ def main(argv=None) -> None:
                          "dt 0.0025 s) against it")
     ap.add_argument("--masses", default="blended,blended_linear")
     ap.add_argument("--meshes", default="24,32,40,48,56,64,80,96")
-    ap.add_argument("--tols", default="1e-3,3e-4,1e-4,3e-5,1e-5")
+    ap.add_argument("--tols", default="1e-3,3e-4,1e-4,3e-5,1e-5,3e-6")
+    ap.add_argument("--resolve", default="auto,waves",
+                    help="the transient step's resolve settings to search (docs/case-format.md)")
     ap.add_argument("--ops-meshes-0", default="96,128,160,192,256")
     ap.add_argument("--ops-meshes-3", default="48,64,80,96,128,160,192,256")
     ap.add_argument("--max-ops-wall", type=float, default=200.0)
