@@ -112,12 +112,11 @@ kind = "static"
 name = "static"
 """
     if motion is not None:
-        rec = read_table(DATA / "quasi_static_chain" / f"{motion}.txt")
-        t = rec[:, 0] - rec[0, 0]
+        t, z = heave_record(motion, duration)
         dur = float(t[-1]) if duration is None else duration
         text += f"""[[support_motions]]
 node = "fairlead"
-z = {_inline(t, rec[:, 3])}
+z = {_inline(t, z)}
 [[steps]]
 kind = "transient"
 name = "heave"
@@ -129,6 +128,21 @@ mass_model = "{mass_model}"
 max_order = {max_order if isinstance(max_order, int) else repr(max_order).replace("'", '"')}
 {_damping(axial_damping)}"""
     return text
+
+
+def heave_record(motion: str, duration: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(t on the case clock, fairlead heave z) of the record ZZP1_A*: 40 s at 0.1 s; longer runs
+    (``duration`` beyond the record, for the cost of long runs) continue it as the sine it
+    samples, A sin(2π t / 10 s) with A 2 m or 5 m (the record is that sine to its 1 mm)."""
+    rec = read_table(DATA / "quasi_static_chain" / f"{motion}.txt")
+    t = rec[:, 0] - rec[0, 0]
+    z = rec[:, 3]
+    if duration is not None and duration + 1.0 > t[-1]:
+        amp = {"ZZP1_A1": 2.0, "ZZP1_A2": 5.0}[motion]
+        extra = np.arange(t[-1] + 0.1, duration + 1.0 + 1e-9, 0.1)
+        t = np.concatenate([t, extra])
+        z = np.concatenate([z, amp * np.sin(2.0 * math.pi * extra / 10.0)])
+    return t, z
 
 
 def chain_metric(times: np.ndarray, fair_tension: np.ndarray, depth: int, motion: str
