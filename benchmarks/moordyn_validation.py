@@ -64,10 +64,11 @@ def catdae_chain(depth, motion, elements, rtol, duration=None):
     c0, w0 = time.process_time(), time.perf_counter()
     tree = catdae.run(load_case(text), progress=False)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    static = np.linalg.norm(tree["static"].to_dataset().reaction.sel(node="fairlead").values)
     ds = tree["heave"].to_dataset()
     t = np.linalg.norm(ds.reaction.sel(node="fairlead").values, axis=-1)
     dur = float(ds.time.values[-1] - ds.time.values[0])
-    return chain_metric(ds.time.values, t, depth, motion), cpu / dur, wall / dur, \
+    return chain_metric(ds.time.values, t, depth, motion, static), cpu / dur, wall / dur, \
         int(ds.attrs["n_steps"])
 
 

@@ -14,13 +14,18 @@ drive and the metrics its test programs.
   at the record's t = -10 s. Metric: max |ΔT - ΔT_ref| / (2 max |ΔT_ref|) over the record's
   t >= 0, ΔT the change of fairlead tension from each code's own static value (the reference's
   static value is the published 2065.4 or 5232.6 kN), at most 0.15. BDF order 2 (``max_order =
-  2``): the order race of ``"auto"`` can pick order 5 on a window of the 2 m record, which then
-  resolves the undamped axial ringing of the top element (the 200 m record at rtol 1e-3: 5539
-  steps and 0.25 against 1321 steps and 0.096 at order 2).
-- MoorDyn's inputs damp the axial strain rate (BA/-zeta: -1.0 for the chain, -0.5 for the
-  jumper); ``axial_damping`` (catdae's ζ at each element's own axial frequency) can add it
-  but is off here: its convention is not MoorDyn's (ratio 1.0 puts the chain off by 0.7-2.4,
-  ratio 0.5 moves the jumper's errors by -0.23 to +0.25 kN at 40 elements).
+  2``): without axial damping the order race of ``"auto"`` picked order 5 on a window of the 2 m
+  record, which then resolved the undamped axial ringing of the top element (the 200 m record
+  at rtol 1e-3: 5539 steps and 0.25 against 1321 steps and 0.096 at order 2).
+- MoorDyn's inputs damp the axial strain rate, BA/-zeta = -1.0 for the chain and -0.5 for the
+  jumper: a viscous force c_d ė on each segment's elongation rate ė with c_d = ζ sqrt(EA m)
+  (MoorDyn's log: "damping set to 8.08e6 N s based on input of -1" for the chain's BA =
+  ζ l sqrt(EA m), l = 10 m). catdae's
+  ``axial_damping = { ratio = ζ }`` (at each element's own axial frequency) has the same c_d =
+  ζ sqrt(EA m), so the scenes carry MoorDyn's ζ as published. Without it the order race and
+  the error of the jumper's case 3 depend on the run's step history (2-8.5 kN at 40 elements).
+  With it the chain's transient starts with the viscous tension of the record's jump from rest
+  to full speed (0.6-1.9 MN for an instant), so the metric takes ΔT from the static step.
 - The Lowe & Langley (2006) jumper (``jumper_toml``): 170 m, d 0.396 m, 165 kg/m, EA 500 MN,
   Cd 1, Ca 1 (EI = 120.8 kN m² is not modelled), from (-100, 0, -55) to (0, 0, -5) in 100 m
   of fresh water, g = 9.807. Cases 2 and 3 move the top 10 m along y or z as
@@ -43,11 +48,12 @@ DATA = Path(__file__).resolve().parent / "data" / "moordyn"
 CHAIN = {200: (700.0, 760.0, 2065.4, 1402.2), 600: (1500.0, 1700.0, 5232.6, 3244.2)}
 # the chain's still-water level: at the fairlead, as published
 SURFACE = 0.0
+RECORD = 30.0  # s of heave compared (the records' t = -10 ... 20 s)
 JUMPER_PERIOD = 27.0
 JUMPER_AMPLITUDE = 10.0
 WAVE_PERIOD = 10.0
-CHAIN_ZETA = None  # MoorDyn: BA/-zeta -1.0 (see the module docstring)
-JUMPER_ZETA = None  # MoorDyn: BA/-zeta -0.5 (see the module docstring)
+CHAIN_ZETA = 1.0  # MoorDyn's BA/-zeta -1.0 (see the module docstring)
+JUMPER_ZETA = 0.5  # MoorDyn's BA/-zeta -0.5
 WAVE_CASES = {4: (230.0, 0.0), 5: (165.0, 45.0), 6: (0.0, 90.0)}  # phase, heading (deg)
 
 
@@ -112,8 +118,8 @@ kind = "static"
 name = "static"
 """
     if motion is not None:
-        t, z = heave_record(motion, duration)
-        dur = float(t[-1]) if duration is None else duration
+        dur = RECORD if duration is None else duration
+        t, z = heave_record(motion, dur)
         text += f"""[[support_motions]]
 node = "fairlead"
 z = {_inline(t, z)}
@@ -132,8 +138,9 @@ max_order = {max_order if isinstance(max_order, int) else repr(max_order).replac
 
 def heave_record(motion: str, duration: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(t on the case clock, fairlead heave z) of the record ZZP1_A*: 40 s at 0.1 s; longer runs
-    (``duration`` beyond the record, for the cost of long runs) continue it as the sine it
-    samples, A sin(2π t / 10 s) with A 2 m or 5 m (the record is that sine to its 1 mm)."""
+    (and any run to 1 s past its end, so that the step ends before the record's own end, where
+    the fairlead would stop dead) continue it as the sine it samples, A sin(2π t / 10 s) with A
+    2 m or 5 m (the record is that sine to its 1 mm)."""
     rec = read_table(DATA / "quasi_static_chain" / f"{motion}.txt")
     t = rec[:, 0] - rec[0, 0]
     z = rec[:, 3]
@@ -145,15 +152,18 @@ def heave_record(motion: str, duration: float | None = None) -> tuple[np.ndarray
     return t, z
 
 
-def chain_metric(times: np.ndarray, fair_tension: np.ndarray, depth: int, motion: str
-                 ) -> float:
+def chain_metric(times: np.ndarray, fair_tension: np.ndarray, depth: int, motion: str,
+                 static: float | None = None) -> float:
     """MoorDyn's dynamic metric for catdae's fairlead tension (N) sampled at ``times`` (case
-    clock, s): max |ΔT - ΔT_ref| / (2 max |ΔT_ref|) over the reference's rows."""
+    clock, s): max |ΔT - ΔT_ref| / (2 max |ΔT_ref|) over the reference's rows, ΔT from the
+    static tension ``static`` (default: the first sample; with axial damping the first sample
+    of the transient holds the viscous tension of the record's start from rest at full speed)."""
     ref = read_table(DATA / "quasi_static_chain" / f"WD{depth:04d}_Chain_{motion}.txt")
     ref = ref[ref[:, 0] + 10.0 <= times[-1] + 1e-9]  # rows the run reached
     t_ref = ref[:, 0] + 10.0  # the record starts at -10 s, the case clock at 0
     d_ref = 1e3 * ref[:, 3] - 1e3 * CHAIN[depth][2]
-    d_own = np.interp(t_ref, times, fair_tension) - fair_tension[0]
+    d_own = np.interp(t_ref, times, fair_tension) - (fair_tension[0] if static is None
+                                                     else static)
     return float(np.max(np.abs(d_own - d_ref)) / (2.0 * np.max(np.abs(d_ref))))
 
 
