@@ -27,6 +27,7 @@ from catdae.model.mesh import build_mesh
 from catdae.model.span import span_quantities
 from catdae.output import engineering, results
 from catdae.output.connectors import with_connector_forces, with_damped_modes
+from catdae.output.fluid import with_static_fluid
 from catdae.output.transient import as_dataset
 from catdae.output.writer import ResultWriter
 from catdae.solvers.damped_modes import solve_damped
@@ -254,6 +255,7 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
         cables=model.cable_summary(sol.X, sol.state),
     )
     ds = with_connector_forces(ds, model.connectors, sol.X)
+    ds = with_static_fluid(ds, model.fluid, sol.X, state.t)  # the current, the wind (§13)
     return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
                                   engineering.rated_strengths(model.case, model.mesh.cable_names))
 

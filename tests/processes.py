@@ -1,6 +1,7 @@
 """A real ``python -m catdae`` process and signals sent to it once it shows that it runs (shared
-by tests/unit/test_interrupts.py and tests/scenes/test_extremes.py): no fixed sleeps, generous
-timeouts."""
+by tests/unit/test_interrupts.py, tests/unit/test_hostile_use.py and
+tests/scenes/test_extremes.py): no fixed sleeps, generous timeouts. ``long_case`` writes the
+scene such a run is interrupted in, ``interrupted_run`` runs it and sends the signal."""
 
 from __future__ import annotations
 
@@ -10,6 +11,9 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
+
+from scene_toml import long_transient
 
 
 def catdae_process(args, cwd, *, snapshot_seconds=None):
@@ -23,6 +27,24 @@ def catdae_process(args, cwd, *, snapshot_seconds=None):
         cmd = [sys.executable, "-c", code, *args]
     return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd,
                             env=dict(os.environ, PYTHONUNBUFFERED="1"))
+
+
+def long_case(path: Path, duration: float = 1000.0) -> Path:
+    """``scene_toml.long_transient`` written to ``path``: a run of it is interrupted long before
+    its end."""
+    path.write_text(long_transient(duration))
+    return path
+
+
+def interrupted_run(folder: Path, sig, out: Path | None = None) -> tuple[int, str, Path]:
+    """``catdae run`` of ``long_case(folder / "long.toml")`` into ``out`` (by default
+    ``folder / "long.nc"``) with the progress bar, sent ``sig`` once the transient runs past
+    t = 1 s. Returns (exit code, stderr, out)."""
+    case = long_case(folder / "long.toml")
+    out = folder / "long.nc" if out is None else out
+    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], folder)
+    code, err = signal_when(proc, sig, transient_runs)
+    return code, err, out
 
 
 def signal_when(proc, sig, ready, timeout=180.0) -> tuple[int, str]:

@@ -4,19 +4,22 @@ A to node B.
 
 ``cable_scene`` writes, in this order and without blank lines::
 
-    title, gravity                       (each only when given)
-    [materials.<material>]  EA, mass, weight (weight only when given)
-    [nodes]                 A, B
+    title, gravity, head    (each only when given; ``head``: further top-level keys)
+    [materials.<material>]  EA, mass, weight, properties (weight only when given;
+                            ``properties``: further fields of the material, e.g. diameter)
+    [nodes]                 A, B, nodes (``nodes``: further nodes, e.g. a ground node)
     [supports]              one ``<name> = "pinned"`` line per entry of ``supports``
     [[cables]]              name, ends = ["A", "B"], material, length, elements, gauss_points
     extra                   verbatim (loads, point masses, support motions, ...)
     steps                   verbatim
 
-Numbers are written with ``num`` (by default ``repr(float(x))``: a TOML float, also for numpy
-scalars; a number given as a string, e.g. ``"4.696e8"``, is written as it stands).
-``elements`` and ``gauss_points`` are written as integers and left out when ``None``. ``extra``
-and ``steps`` get a closing newline if they lack one. A string in ``supports`` that already
-holds ``=`` (e.g. ``'B = ["y", "z"]'``) is written as it stands.
+The numbers of the nodes, EA, mass, weight, length and gravity are written with ``num`` (by
+default ``repr(float(x))``: a TOML float, also for numpy scalars; a number given as a string,
+e.g. ``"4.696e8"``, is written as it stands; a sequence, e.g. a gravity vector, as an array of
+such numbers). ``elements`` and ``gauss_points`` are written as integers and left out when
+``None``; ``head`` and ``properties`` values as ``value`` writes them (below). ``extra`` and
+``steps`` get a closing newline if they lack one. A string in ``supports`` that already holds
+``=`` (e.g. ``'B = ["y", "z"]'``) is written as it stands.
 
 ``static_step``, ``modal_step`` and ``transient_step`` give the ``[[steps]]`` blocks most scenes
 end with.
@@ -26,11 +29,13 @@ Scenes of several cables, or with other node names, are written by ``scene`` in 
 ``extra`` and ``steps``); ``cable_scene`` is ``scene`` with one cable from A to B. The blocks of
 the arrays of tables are written by ``table`` (one ``key = value`` line per field given, in the
 order given, ``None`` left out) and its named forms ``cable``, ``point_mass``, ``load``,
-``distributed_load``, ``support_motion`` and ``step``. Values: a bool as ``true``/``false``, an
-integer as such, any other number as ``num`` writes it, a string quoted (``raw(...)`` as it
-stands), a sequence as an array and a mapping as an inline table.
+``distributed_load``, ``support_motion``, ``spring``, ``damper``, ``bar`` and ``step``; a plain
+table (``[seabed]``, ``[ground]``, ...) by ``section``. Values (``value``): a bool as
+``true``/``false``, an integer as such, any other number as ``num`` writes it, a string quoted
+(``raw(...)`` as it stands), a sequence as an array and a mapping as an inline table.
 
-Shared scenes: ``long_transient`` (a transient that is always interrupted before its end).
+Shared scenes: ``long_transient`` (a transient that is always interrupted before its end) and
+``falling_mass`` (a mass dropped onto a slack rope: the snap).
 """
 
 from __future__ import annotations
@@ -78,6 +83,11 @@ def table(array: str, /, **fields) -> str:
     return "".join(line + "\n" for line in [f"[[{array}]]", *_lines(fields)])
 
 
+def section(name: str, /, **fields) -> str:
+    """One ``[name]`` table: a ``key = value`` line per field that is not ``None``."""
+    return "".join(line + "\n" for line in [f"[{name}]", *_lines(fields)])
+
+
 def cable(name: str, ends=("A", "B"), material: str = "m", length=None, elements=None,
           **more) -> str:
     """A ``[[cables]]`` block (``more``: gauss_points, form, ... in the order given)."""
@@ -109,6 +119,21 @@ def support_motion(node: str, **axes) -> str:
     return table("support_motions", node=node, **axes)
 
 
+def spring(name: str, ends, stiffness, **more) -> str:
+    """A ``[[springs]]`` block (``more``: length, ...)."""
+    return table("springs", name=name, ends=list(ends), stiffness=stiffness, **more)
+
+
+def damper(name: str, ends, coefficient, **more) -> str:
+    """A ``[[dampers]]`` block."""
+    return table("dampers", name=name, ends=list(ends), coefficient=coefficient, **more)
+
+
+def bar(name: str, ends, EA, **more) -> str:
+    """A ``[[bars]]`` block (``more``: mass, length, ...)."""
+    return table("bars", name=name, ends=list(ends), EA=EA, **more)
+
+
 def step(kind: str, /, name: str | None = None, **fields) -> str:
     """A ``[[steps]]`` block of any kind (``name`` left out when ``None``)."""
     return table("steps", kind=kind, name=name, **fields)
@@ -135,15 +160,23 @@ def scene(*, nodes: Mapping[str, Sequence], cables: str | Sequence[str],
 def cable_scene(*, B, L0, EA, mass, elements: int | None = None, A=(0.0, 0.0, 0.0),
                 weight=None, gauss_points: int | None = None,
                 supports: Sequence[str] = ("A", "B"), title: str | None = None, gravity=None,
+                head: Mapping | None = None, properties: Mapping | None = None,
+                nodes: Mapping[str, Sequence] | None = None,
                 material: str = "m", cable: str = "c", extra: str = "", steps: str = "",
                 num: Callable[[object], str] = _float) -> str:
     """One cable from node A to node B, as TOML text (see the module docstring for the layout)."""
     def n(x):
-        return None if x is None else raw(num(x))
+        if x is None or isinstance(x, raw):
+            return x
+        if isinstance(x, str | numbers.Real):
+            return raw(num(x))
+        return [n(v) for v in x]
 
-    return scene(head={"title": title, "gravity": n(gravity)},
-                 materials={material: {"EA": n(EA), "mass": n(mass), "weight": n(weight)}},
-                 nodes={"A": [n(a) for a in A], "B": [n(b) for b in B]}, supports=supports,
+    return scene(head={"title": title, "gravity": n(gravity), **(head or {})},
+                 materials={material: {"EA": n(EA), "mass": n(mass), "weight": n(weight),
+                                       **(properties or {})}},
+                 nodes={"A": n(A), "B": n(B), **{k: n(x) for k, x in (nodes or {}).items()}},
+                 supports=supports,
                  cables=_cable(cable, ("A", "B"), material, n(L0), elements,
                                gauss_points=gauss_points),
                  extra=extra, steps=steps, num=num)
@@ -180,3 +213,17 @@ def long_transient(duration=1000.0) -> str:
         extra=load("push", [0.0, 1.0, 0.0], node="c.1"),
         steps=static_step("static") + transient_step("dyn", duration, 0.01, rtol=1e-6,
                                                      atol=1e-9, remove=["push"]))
+
+
+def falling_mass(rope_mass, *, duration, M=1000.0, L0=10.0, EA=1e7, x_off=0.3, fall=0.5,
+                 output_interval=0.05) -> str:
+    """A mass M (point mass "bob" at B) on a slack rope of one element (``rope_mass`` per metre,
+    material "rope"), released from rest ``fall`` m below the taut length with B ``x_off`` m
+    aside (so that the slack rope has a shape); no weight given: the default gravity. One
+    lumped-mass transient "drop" of ``duration`` seconds: the snap as the rope catches it."""
+    return cable_scene(
+        B=(x_off, 0.0, -(L0 - fall)), L0=L0, EA=EA, mass=rope_mass, elements=1,
+        supports=("A",), material="rope",
+        extra=point_mass("bob", M, node="B"),
+        steps=step("transient", "drop", mass_model="lumped", duration=duration,
+                   output_interval=output_interval))

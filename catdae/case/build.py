@@ -1,6 +1,6 @@
 """Passes 2 and 3: validate each item, check cross references and physics, build the model.
 
-Every problem is collected (:meth:`_Builder.problem`) before anything is raised, so that one
+Every problem is collected (:meth:`Builder.problem`) before anything is raised, so that one
 :class:`~catdae.errors.CaseError` lists all of them with their field paths. An item that fails
 pass 2 is left out of pass 3, but its name still counts as declared, so that one typo does not
 cascade into a list of "unknown" errors elsewhere.
@@ -16,17 +16,24 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
-from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, _CablesPass  # noqa: F401
-from catdae.case.build_connectors import _ConnectorsPass, connector_ends
-from catdae.case.build_fluid import _FluidPass
-from catdae.case.build_seabed import _SeabedPass
-from catdae.case.build_steps import _StepsPass
-from catdae.case.build_time import _TimePass
+from catdae.case.build_cables import COINCIDENT_TOL, MAX_STRAIN, CablesPass  # noqa: F401
+from catdae.case.build_connectors import ConnectorsPass, connector_ends
+from catdae.case.build_fluid import FluidPass
+from catdae.case.build_seabed import SeabedPass
+from catdae.case.build_steps import StepsPass
+from catdae.case.build_time import TimePass
 from catdae.case.fluid import line_fluid
 from catdae.case.frame import gravity_rotation, local_axes
-from catdae.case.ground import _GroundPass
+from catdae.case.ground import GroundPass
 from catdae.case.limits import MAX_NAME_LENGTH, size_problems
-from catdae.case.messages import _fmt_path, _found, _is_number, _message, _short, _unknown
+from catdae.case.messages import (
+    fmt_path,
+    found_text,
+    is_number,
+    pydantic_message,
+    shorten,
+    unknown_word,
+)
 from catdae.case.model import (
     AXES,
     Case,
@@ -35,13 +42,14 @@ from catdae.case.model import (
 )
 from catdae.case.names import cable_of
 from catdae.case.schema import (
-    _VEC3,
-    _Load,
-    _Material,
-    _PointMass,
-    _Top,
+    POSITION,
+    VEC3,
+    LoadSchema,
+    MaterialSchema,
+    PointMassSchema,
+    TopSchema,
 )
-from catdae.case.sweep import _SweepPass
+from catdae.case.sweep import SweepPass
 from catdae.errors import CaseError
 
 # bidirectional formatting: embeddings, overrides, isolates (and in names the marks too)
@@ -59,8 +67,8 @@ def _bounded(message: str) -> str:
     return f"{message[:MAX_MESSAGE - 40]}... (message cut, {len(message)} characters)"
 
 
-class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, _FluidPass,
-               _GroundPass, _SeabedPass):
+class Builder(CablesPass, ConnectorsPass, StepsPass, SweepPass, TimePass, FluidPass,
+               GroundPass, SeabedPass):
     """Collects problems while turning the parsed TOML into frozen objects."""
 
     def __init__(self, path: str | None, base_dir: Path):
@@ -69,7 +77,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         self.problems: list[tuple[str, str]] = []
 
     def problem(self, parts: Iterable[str | int], message: str) -> None:
-        self.problems.append((_fmt_path(parts), _bounded(message)))
+        self.problems.append((fmt_path(parts), _bounded(message)))
 
     def validate(self, model: type[BaseModel], data: Any, prefix: tuple,
                  foreign: Mapping[str, str] | None = None) -> tuple[Any, bool]:
@@ -86,7 +94,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
             errors = exc.errors()
         fields = list(model.model_fields)
         for err in errors:
-            self.problem(prefix + tuple(err["loc"]), _message(err, fields, foreign or {}))
+            self.problem(prefix + tuple(err["loc"]), pydantic_message(err, fields, foreign or {}))
         bad = {err["loc"][0] for err in errors if err["loc"]}
         try:
             return model.model_validate({k: v for k, v in data.items() if k not in bad}), False
@@ -97,14 +105,14 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
 
     def build(self, data: dict[str, Any], *, text: str, name: str) -> Case:
         try:
-            top = _Top.model_validate(data)
+            top = TopSchema.model_validate(data)
             bad: set = set()
         except ValidationError as exc:  # report, then go on with the well-formed sections
-            fields = list(_Top.model_fields)
+            fields = list(TopSchema.model_fields)
             for err in exc.errors():
-                self.problem(err["loc"], _message(err, fields, {}))
+                self.problem(err["loc"], pydantic_message(err, fields, {}))
             bad = {err["loc"][0] for err in exc.errors()}
-            top = _Top.model_validate({k: v for k, v in data.items() if k not in bad})
+            top = TopSchema.model_validate({k: v for k, v in data.items() if k not in bad})
         self.gravity, self.gravity_direction = self.gravity_vector(top.gravity)
         self.material_names = set(top.materials)
         self.support_names = set(top.supports)
@@ -125,8 +133,9 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
             if held:
                 self.problem(("nodes", key), f"node {key!r} is not an end of any cable and "
                              "not supported: nothing holds it (remove it, or use it)")
-        point_masses = self.located(top.point_masses, "point_masses", _PointMass, cables, nodes)
-        loads = self.located(top.loads, "loads", _Load, cables, nodes)
+        point_masses = self.located(top.point_masses, "point_masses", PointMassSchema, cables,
+                                    nodes)
+        loads = self.located(top.loads, "loads", LoadSchema, cables, nodes)
         distributed = self.distributed(top.distributed_loads, cables)
         connectors = self.connectors(top, cables, nodes)
         self.connector_items = connectors  # what a step's sweep may vary
@@ -136,10 +145,12 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
         ground = self.ground(top.ground, self.gravity_direction)
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
-        self.fluid_lines(top.materials, water, air)
+        self.fluid_lines(top.materials)
         seabed = self.seabed(top.seabed, nodes, supports, materials, steps,
                              water_floor=None if water is None or not math.isfinite(water.depth)
-                             else water.surface - water.depth)
+                             else water.surface - water.depth,
+                             water_surface=None if water is None else water.surface)
+        self.water_floor(water, nodes, supports, seabed)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)
@@ -161,7 +172,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
             raise CaseError(self.path, problems)
         return case
 
-    def names(self, top: _Top) -> None:
+    def names(self, top: TopSchema) -> None:
         """Names and texts end up in the results file, in messages and in ParaView: no control
         characters (netCDF cuts a string at NUL), no bidirectional controls (U+202E shows a
         name reversed), and names of at most MAX_NAME_LENGTH characters (every mesh node and
@@ -184,29 +195,29 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
                 continue  # refused by the rule of group names (steps())
             if bad:
                 self.problem(where, f"expected text without control characters, found "
-                             f"{_short(text)} (U+{ord(bad[0]):04X})")
+                             f"{shorten(text)} (U+{ord(bad[0]):04X})")
             elif bidi:
                 self.problem(where, "expected text without bidirectional control characters "
                              f"(they reorder what is shown), found U+{ord(bidi[0]):04X} in "
-                             f"{_short(text.encode('unicode_escape').decode('ascii'))}")
+                             f"{shorten(text.encode('unicode_escape').decode('ascii'))}")
             elif not text_field and len(text) > MAX_NAME_LENGTH:
                 self.problem(where, f"a name of {len(text)} characters, above the limit of "
-                             f"{MAX_NAME_LENGTH}; found {_short(text)}")
+                             f"{MAX_NAME_LENGTH}; found {shorten(text)}")
 
     def gravity_vector(self, raw: Any) -> tuple[float, tuple[float, float, float]]:
         """``gravity``: a number (m/s², along -z) or ``[gx, gy, gz]``; returns (|g|, unit)."""
         down = (0.0, 0.0, -1.0)
-        if _is_number(raw):
+        if is_number(raw):
             if raw < 0:
                 self.problem(("gravity",), f"expected a value >= 0 (m/s², along -z) or a vector "
-                             f"[gx, gy, gz], found {_found(raw)}")
+                             f"[gx, gy, gz], found {found_text(raw)}")
                 return 9.81, down
             return float(raw), down
         try:
-            g = _VEC3.validate_python(raw)
+            g = VEC3.validate_python(raw)
         except ValidationError:
             self.problem(("gravity",), "expected a number >= 0 (m/s², along -z) or a vector "
-                         f"[gx, gy, gz] of 3 finite numbers (m/s²), found {_found(raw)}")
+                         f"[gx, gy, gz] of 3 finite numbers (m/s²), found {found_text(raw)}")
             return 9.81, down
         norm = math.sqrt(sum(x * x for x in g))
         if norm == 0.0:
@@ -230,7 +241,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
     def materials(self, raw: dict[str, dict]) -> dict[str, Material]:
         out = {}
         for key, item in raw.items():
-            m, complete = self.validate(_Material, item, ("materials", key))
+            m, complete = self.validate(MaterialSchema, item, ("materials", key))
             if complete:
                 weight = m.mass * self.gravity if m.weight is None else m.weight
                 out[key] = Material(key, m.EA, m.mass, weight, m.damping,
@@ -252,12 +263,12 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
                              "a dot are reserved for mesh nodes such as 'main.7'")
                 ok = False
             try:
-                xyz = _VEC3.validate_python(value)
+                xyz = POSITION.validate_python(value)
             except ValidationError as exc:
                 for err in exc.errors():
-                    msg = _message(err, (), {})
+                    msg = pydantic_message(err, (), {})
                     if err["type"] == "list_type":
-                        msg = f"expected coordinates [x, y, z] in m, found {_found(value)}"
+                        msg = f"expected coordinates [x, y, z] in m, found {found_text(value)}"
                     self.problem(where + tuple(err["loc"]), msg)
                 continue
             if ok:
@@ -270,14 +281,14 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
             where = ("supports", key)
             known = key in self.node_names
             if not known:
-                self.problem(where, _unknown(key, "node", sorted(self.node_names)))
+                self.problem(where, unknown_word(key, "node", sorted(self.node_names)))
             if value == "pinned":
                 axes: tuple[str, ...] = AXES
             elif isinstance(value, list) and value and all(isinstance(a, str) for a in value):
                 bad = [i for i, a in enumerate(value) if a not in AXES]
                 for i in bad:
                     self.problem(where + (i,), f"expected one of 'x', 'y', 'z', found "
-                                 f"{_found(value[i])}")
+                                 f"{found_text(value[i])}")
                 dup = {a for a in value if value.count(a) > 1}
                 if dup:
                     self.problem(where, f"axis {sorted(dup)[0]!r} is listed twice")
@@ -286,13 +297,13 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
                 axes = tuple(a for a in AXES if a in value)
             else:
                 self.problem(where, 'expected "pinned" or a non-empty list of fixed axes such '
-                             f'as ["y"], found {_found(value)}')
+                             f'as ["y"], found {found_text(value)}')
                 continue
             if known:
                 out[key] = axes
         return out
 
-    def unique_names(self, top: _Top) -> None:
+    def unique_names(self, top: TopSchema) -> None:
         """Point masses, loads and distributed loads share one namespace.
 
         ``removable``: the names a step may ``add`` or ``remove`` (distributed loads only
@@ -309,7 +320,7 @@ class _Builder(_CablesPass, _ConnectorsPass, _StepsPass, _SweepPass, _TimePass, 
                     nm = f"distributed{i}"
                 if not isinstance(nm, str):
                     continue
-                here = _fmt_path((section, i))
+                here = fmt_path((section, i))
                 if nm in seen:
                     self.problem((section, i, "name"), f"duplicate name {nm!r} (also "
                                  f"{seen[nm]}); point masses and loads share one namespace")

@@ -1,6 +1,6 @@
 """Pass 3 for the scene along the cables: cables with their form-finding targets, the things
 placed on them (point masses, loads, distributed loads and their coverage). A mixin of
-:class:`~catdae.case.build._Builder`, whose ``problem`` and ``validate`` collect what is
+:class:`~catdae.case.build.Builder`, whose ``problem`` and ``validate`` collect what is
 wrong (see ``build``)."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from catdae.case.messages import _found, _unknown
+from catdae.case.messages import found_text, unknown_word
 from catdae.case.model import (
     Cable,
     DistributedLoad,
@@ -22,16 +22,16 @@ from catdae.case.model import (
 from catdae.case.names import cable_of, mesh_node, split_mesh_node
 from catdae.case.schema import (
     FORM_TARGETS,
-    _Cable,
-    _DistributedLoad,
-    _Form,
+    CableSchema,
+    DistributedLoadSchema,
+    FormSchema,
 )
 
 COINCIDENT_TOL = 1e-9  # m: cable ends closer than this coincide
 MAX_STRAIN = 0.5  # a chord longer than (1 + MAX_STRAIN) * length is rejected
 
 
-class _CablesPass:
+class CablesPass:
     """Cables and what lies on them (methods of ``_Builder``)."""
 
     def cables(self, raw: list[dict], materials: dict, nodes: dict) -> dict[str, tuple]:
@@ -50,7 +50,7 @@ class _CablesPass:
                 continue
             if isinstance(nm, str):
                 seen[nm] = i
-            c, ok = self.validate(_Cable, item, where)
+            c, ok = self.validate(CableSchema, item, where)
             if c is None:
                 continue
             if "." in c.name:
@@ -64,12 +64,12 @@ class _CablesPass:
             for j, end in enumerate(c.ends):
                 if end not in self.node_names:
                     self.problem(where + ("ends", j),
-                                 _unknown(end, "node", sorted(self.node_names)))
+                                 unknown_word(end, "node", sorted(self.node_names)))
                     ok = False
             if c.material not in materials:
                 if c.material not in self.material_names:
                     self.problem(where + ("material",),
-                                 _unknown(c.material, "material", sorted(self.material_names)))
+                                 unknown_word(c.material, "material", sorted(self.material_names)))
                 ok = False
             form = self.form(item, c, where)
             ok = ok and form is not False
@@ -111,7 +111,7 @@ class _CablesPass:
             return None
         if c.form is None:  # present but not a table: already reported
             return False
-        v, complete = self.validate(_Form, c.form, where + ("form",))
+        v, complete = self.validate(FormSchema, c.form, where + ("form",))
         if not complete:
             return False
         given = [k for k in FORM_TARGETS if getattr(v, k) is not None]
@@ -128,7 +128,7 @@ class _CablesPass:
                 return False
             if v.at not in c.ends:
                 self.problem(where + ("form", "at"), f"expected an end of the cable, one of "
-                             f"{list(c.ends)}, found {_found(v.at)}")
+                             f"{list(c.ends)}, found {found_text(v.at)}")
                 return False
         elif v.at is not None:
             self.problem(where + ("form", "at"), "at applies to form = { tension = ..., at = "
@@ -156,7 +156,7 @@ class _CablesPass:
         choices = sorted(self.node_names) + [
             mesh_node(n, k) for n, (_, c) in cables.items() for k in range(1, min(c.elements, 100))
         ]
-        self.problem(where, _unknown(ref, "node", choices))
+        self.problem(where, unknown_word(ref, "node", choices))
         return False
 
     def located(self, raw: list[dict], section: str, model: type[BaseModel], cables: dict,
@@ -202,7 +202,8 @@ class _CablesPass:
                          "measured along")
             return False
         if v.cable not in self.cable_names:
-            self.problem(where + ("cable",), _unknown(v.cable, "cable", sorted(self.cable_names)))
+            self.problem(where + ("cable",),
+                         unknown_word(v.cable, "cable", sorted(self.cable_names)))
             return False
         if v.s is None:
             self.problem(where + ("s",), "missing: a point on a cable needs s, the unstrained "
@@ -226,12 +227,12 @@ class _CablesPass:
         out = []
         for i, item in enumerate(raw):
             where = ("distributed_loads", i)
-            v, ok = self.validate(_DistributedLoad, item, where)
+            v, ok = self.validate(DistributedLoadSchema, item, where)
             if v is None:
                 continue
             if v.cable not in self.cable_names:
                 self.problem(where + ("cable",),
-                             _unknown(v.cable, "cable", sorted(self.cable_names)))
+                             unknown_word(v.cable, "cable", sorted(self.cable_names)))
                 ok = False
             time = None if v.time is None else self.time_function(v.time, where + ("time",))
             if not v.active and v.name is None:
@@ -287,7 +288,7 @@ def _mesh_node_problem(ref: str, elements: Mapping[str, int]) -> str | None:
     """Why ``<cable>.<k>`` is not a mesh node of one of ``elements`` (cable -> count), or None."""
     cable, k = split_mesh_node(ref) or ("", "")
     if cable not in elements:
-        return _unknown(ref, "node", sorted(elements))
+        return unknown_word(ref, "node", sorted(elements))
     n = elements[cable]
     if k.isdigit() and k.isascii() and 1 <= int(k) <= n - 1:
         if k == str(int(k)):

@@ -1,5 +1,5 @@
 """Pass 2 and 3 for the connectors of a case: ``[[springs]]``, ``[[dampers]]`` and ``[[bars]]``
-(docs/case-format.md, Connectors). A mixin of :class:`~catdae.case.build._Builder`, whose
+(docs/case-format.md, Connectors). A mixin of :class:`~catdae.case.build.Builder`, whose
 ``problem`` and ``validate`` collect what is wrong (see ``build``).
 
 Each connector joins two nodes, ``ends = [node, node]``: named nodes of ``[nodes]`` (a
@@ -14,7 +14,7 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from catdae.case.messages import _unknown
+from catdae.case.messages import unknown_word
 
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 _Pos = Annotated[float, Field(gt=0)]
@@ -95,7 +95,7 @@ def connector_ends(top: Any) -> set[str]:
             for e in item["ends"] if isinstance(e, str)}
 
 
-class _ConnectorsPass:
+class ConnectorsPass:
     """Springs, dampers and bars (methods of ``_Builder``)."""
 
     def connectors(self, top: Any, cables: dict, nodes: dict) -> dict[str, tuple]:
@@ -150,5 +150,5 @@ class _ConnectorsPass:
         choices = sorted(self.node_names) + [
             f"{n}.{k}" for n, (_, c) in cables.items() for k in range(1, min(c.elements, 100))
         ]
-        self.problem(where, _unknown(ref, "node", choices))
+        self.problem(where, unknown_word(ref, "node", choices))
         return False

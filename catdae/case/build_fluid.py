@@ -1,5 +1,5 @@
 """Pass 3 for the fluids around the cables: ``[water]`` and ``[air]`` (docs/case-format.md,
-"Water and air"). A mixin of :class:`~catdae.case.build._Builder`, whose ``problem``,
+"Water and air"). A mixin of :class:`~catdae.case.build.Builder`, whose ``problem``,
 ``validate`` and ``time_function`` collect what is wrong."""
 
 from __future__ import annotations
@@ -10,14 +10,15 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, Field
 
 from catdae.case.fluid import Air, Current, Water, Waves, Wind
-from catdae.case.messages import _found
-from catdae.case.schema import _STRICT, _VEC3, NonNeg, Pos, TomlTable, Vec3
+from catdae.case.frame import gravity_rotation
+from catdae.case.messages import found_text
+from catdae.case.schema import STRICT, VEC3, NonNeg, Pos, TomlTable, Vec3
 
 _Angle = Annotated[float, Field(ge=-360.0, le=360.0)]
 
 
 class _Water(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     density: Pos = 1025.0
     surface: float = 0.0
     depth: Pos | None = None
@@ -26,26 +27,26 @@ class _Water(BaseModel):
 
 
 class _Air(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     density: Pos = 1.225
     wind: Any = None  # a vector, or a profile table: checked by the builder
 
 
 class _Profile(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     z: Annotated[list[float], Field(min_length=1)]
     velocity: Annotated[list[Vec3], Field(min_length=1)]
     time: TomlTable | None = None
 
 
 class _UniformFlow(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     velocity: Vec3
     time: TomlTable | None = None
 
 
 class _WindProfile(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     speed: NonNeg
     direction: _Angle = 0.0
     profile: Literal["power", "log", "uniform"] = "uniform"
@@ -57,7 +58,7 @@ class _WindProfile(BaseModel):
 
 
 class _Airy(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["airy"]
     height: Pos
     period: Pos
@@ -67,7 +68,7 @@ class _Airy(BaseModel):
 
 
 class _Jonswap(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["jonswap"]
     hs: Pos
     tp: Pos
@@ -81,7 +82,7 @@ class _Jonswap(BaseModel):
 _WAVE_MODELS: dict[str, type[BaseModel]] = {"airy": _Airy, "jonswap": _Jonswap}
 
 
-class _FluidPass:
+class FluidPass:
     """``[water]`` and ``[air]`` (methods of ``_Builder``)."""
 
     def water(self, raw: dict | None) -> Water | None:
@@ -89,7 +90,7 @@ class _FluidPass:
             return None
         where = ("water",)
         if not isinstance(raw, dict):
-            self.problem(where, f"expected a table [water], found {_found(raw)}")
+            self.problem(where, f"expected a table [water], found {found_text(raw)}")
             return None
         v, complete = self.validate(_Water, raw, where)
         if v is None:
@@ -100,6 +101,9 @@ class _FluidPass:
             kind, w = self.kinded(v.waves, where + ("waves",), _WAVE_MODELS, "wave kind")
             if kind is not None:
                 waves = Waves(kind=kind, **w.model_dump(exclude={"kind"}))
+            if kind is not None and not self.gravity > 0.0:
+                self.problem(where + ("waves",), "waves need gravity > 0 (their dispersion "
+                             f"ω² = g k tanh(k h)), found gravity = {self.gravity:g} m/s²")
         if not complete:
             return None
         depth = math.inf if v.depth is None else float(v.depth)
@@ -110,7 +114,7 @@ class _FluidPass:
             return None
         where = ("air",)
         if not isinstance(raw, dict):
-            self.problem(where, f"expected a table [air], found {_found(raw)}")
+            self.problem(where, f"expected a table [air], found {found_text(raw)}")
             return None
         if "waves" in raw:
             self.problem(where + ("waves",), "waves belong to [water]: there are no waves in "
@@ -155,8 +159,12 @@ class _FluidPass:
             self.problem(where + ("roughness",), f"expected a roughness length below the "
                          f"reference_height {p.reference_height:g} m, found {p.roughness:g}")
             return None
+        # towards ``direction`` in the plane normal to gravity, from the gravity frame's first
+        # axis towards its second (global x and y with gravity along -z; catdae.case.frame)
         th = math.radians(p.direction)
-        vec = (p.speed * math.cos(th), p.speed * math.sin(th), 0.0)
+        e1, e2, _ = gravity_rotation(self.gravity_direction)
+        vec = tuple(float(p.speed * (math.cos(th) * a + math.sin(th) * b))
+                    for a, b in zip(e1, e2, strict=True))
         return Wind(p.profile, vec, float(p.exponent or p.roughness or 0.0),
                     float(p.reference_height), p.ground, tf)
 
@@ -167,18 +175,18 @@ class _FluidPass:
             return None
         if isinstance(raw, list):
             try:
-                vec = _VEC3.validate_python(raw)
+                vec = VEC3.validate_python(raw)
             except Exception:  # noqa: BLE001 - reported below
                 vec = None
             if vec is None:
                 self.problem(where, f"expected a velocity [ux, uy, uz] of 3 finite numbers "
-                             f"(m/s), found {_found(raw)}")
+                             f"(m/s), found {found_text(raw)}")
                 return None
             return Current((), (tuple(float(x) for x in vec),), None)
         if not isinstance(raw, dict):
             self.problem(where, "expected a velocity [ux, uy, uz] (m/s) or a table "
                          + ("{ z = [...], velocity = [[ux, uy, uz], ...] }" if profile else
-                            "{ speed, direction, profile, ... }") + f", found {_found(raw)}")
+                            "{ speed, direction, profile, ... }") + f", found {found_text(raw)}")
             return None
         if "z" in raw and profile:
             v, ok = self.validate(_Profile, raw, where)
@@ -206,9 +214,8 @@ class _FluidPass:
         return Current(tuple(float(x) for x in z),
                        tuple(tuple(float(x) for x in u) for u in vel), tf)
 
-    def fluid_lines(self, materials_raw: dict, water: Water | None, air: Air | None) -> None:
-        """Fluid coefficients need a diameter; waves need a water depth; no fluid with a
-        gravity vector off -z."""
+    def fluid_lines(self, materials_raw: dict) -> None:
+        """Fluid coefficients need a diameter."""
         for key, item in materials_raw.items():
             if not isinstance(item, dict) or item.get("diameter") is not None:
                 continue
@@ -216,8 +223,22 @@ class _FluidPass:
                 if f in item:
                     self.problem(("materials", key, f), f"{f} needs the line's diameter "
                                  "(add diameter = ... in m)")
-        if (water is not None or air is not None) and \
-                self.gravity_direction != (0.0, 0.0, -1.0):
-            self.problem(("water",) if water is not None else ("air",),
-                         "water and air need gravity along -z (a number for gravity); a "
-                         "gravity vector is not supported with fluids")
+
+    def water_floor(self, water: Water | None, nodes: dict, supports: dict, seabed) -> None:
+        """With waves over a finite depth, the wave kinematics hold down to the floor at
+        surface - depth only: no support and no seabed below it."""
+        if water is None or water.waves is None or not math.isfinite(water.depth):
+            return
+        floor = water.surface - water.depth
+        tol = 1e-9 * max(1.0, abs(floor))
+        if seabed is not None and seabed.z < floor - tol:
+            self.problem(("seabed", "z"), f"the seabed at z = {seabed.z:g} m lies below the "
+                         f"water's floor surface - depth = {floor:g} m, where the waves' "
+                         "kinematics end: expected a [water] depth reaching the seabed")
+        for name in supports:
+            p = nodes.get(name)
+            if p is not None and self.height(p) < floor - tol:
+                self.problem(("water", "depth"), f"support {name!r} (z = {self.height(p):g} "
+                             f"m) lies below the water's floor surface - depth = {floor:g} m, "
+                             "where the waves' kinematics end: expected a depth reaching it")
+

@@ -11,7 +11,7 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from catdae.case.messages import _found, _is_number
+from catdae.case.messages import found_text, is_number
 from catdae.case.model import Seabed
 
 _STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
@@ -32,23 +32,24 @@ class _Seabed(BaseModel):
     friction_velocity: Annotated[float, Field(gt=0)] = 0.01
 
 
-class _SeabedPass:
-    """Mixin of the case builder (catdae.case.build._Builder)."""
+class SeabedPass:
+    """Mixin of the case builder (catdae.case.build.Builder)."""
 
     def seabed(self, raw: dict | None, nodes: dict, supports: dict, materials: dict,
-               steps: list, water_floor: float | None = None) -> Seabed | None:
+               steps: list, water_floor: float | None = None,
+               water_surface: float | None = None) -> Seabed | None:
         if raw is None:
             return None
         where = ("seabed",)
         if not isinstance(raw, dict):
-            self.problem(where, f"expected a table [seabed], found {_found(raw)}")
+            self.problem(where, f"expected a table [seabed], found {found_text(raw)}")
             return None
         sb, complete = self.validate(_Seabed, raw, where)
         if sb is None:
             return None
         axial = lateral = 0.0
         fr = sb.friction
-        if _is_number(fr) and not isinstance(fr, bool) and fr >= 0:
+        if is_number(fr) and not isinstance(fr, bool) and fr >= 0:
             axial = lateral = float(fr)
         elif isinstance(fr, dict):
             f, ok = self.validate(_Friction, fr, where + ("friction",))
@@ -58,7 +59,7 @@ class _SeabedPass:
                 axial, lateral = f.axial, f.lateral
         else:
             self.problem(where + ("friction",), "expected a Coulomb coefficient >= 0 or a "
-                         f"table {{ axial = .., lateral = .. }}, found {_found(fr)}")
+                         f"table {{ axial = .., lateral = .. }}, found {found_text(fr)}")
             complete = False
         z = sb.z if sb.z is not None else water_floor
         if z is None:
@@ -67,10 +68,14 @@ class _SeabedPass:
             return None
         for name in supports:
             p = nodes.get(name)
-            if p is not None and self._height(p) < z - 1e-9 * max(1.0, abs(z)):
+            if p is not None and self.height(p) < z - 1e-9 * max(1.0, abs(z)):
                 self.problem(where + ("z",), f"the seabed at z = {z:g} m lies above support "
-                             f"{name!r} (z = {self._height(p):g} m): supports must be on or "
+                             f"{name!r} (z = {self.height(p):g} m): supports must be on or "
                              "above the seabed")
+        if water_surface is not None and z > water_surface:
+            self.problem(where + ("z",), f"the seabed at z = {z:g} m lies above the still-water "
+                         f"level [water] surface = {water_surface:g} m: expected a seabed under "
+                         "the water (for dry ground leave out [water])")
         if sb.stiffness is None:
             for i, st in enumerate(steps):
                 if st.kind in ("modal", "transient"):
@@ -89,7 +94,7 @@ class _SeabedPass:
                       friction_axial=axial, friction_lateral=lateral,
                       friction_velocity=sb.friction_velocity)
 
-    def _height(self, p) -> float:
+    def height(self, p) -> float:
         """Height of a point along "up" (-gravity)."""
         g = self.gravity_direction
         return -(p[0] * g[0] + p[1] * g[1] + p[2] * g[2])

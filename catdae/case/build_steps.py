@@ -1,5 +1,5 @@
 """Pass 3 for the steps of a case: support motions, steps with their temperature, presence
-(add/remove) and damping. A mixin of :class:`~catdae.case.build._Builder`, whose
+(add/remove) and damping. A mixin of :class:`~catdae.case.build.Builder`, whose
 ``problem`` and ``validate`` collect what is wrong (see ``build``)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from catdae.case.messages import _fmt_path, _found, _is_number, _short, _unknown
+from catdae.case.messages import fmt_path, found_text, is_number, shorten, unknown_word
 from catdae.case.model import (
     AXES,
     AxialDamping,
@@ -20,15 +20,15 @@ from catdae.case.model import (
     SupportMotion,
 )
 from catdae.case.schema import (
-    _DAMPING_MODELS,
-    _STEP_MODELS,
-    _AxialDamping,
-    _SupportMotion,
+    DAMPING_MODELS,
+    STEP_MODELS,
+    AxialDampingSchema,
+    SupportMotionSchema,
 )
 from catdae.case.timefunc_compose import Scaled
 
 
-class _StepsPass:
+class StepsPass:
     """Support motions and steps (methods of ``_Builder``)."""
 
     def support_motions(self, raw: list[dict], nodes: dict, supports: dict) -> list:
@@ -36,11 +36,12 @@ class _StepsPass:
         seen: dict[str, int] = {}
         for i, item in enumerate(raw):
             where = ("support_motions", i)
-            v, ok = self.validate(_SupportMotion, item, where)
+            v, ok = self.validate(SupportMotionSchema, item, where)
             if v is None:
                 continue
             if v.node not in self.node_names:
-                self.problem(where + ("node",), _unknown(v.node, "node", sorted(self.node_names)))
+                self.problem(where + ("node",),
+                             unknown_word(v.node, "node", sorted(self.node_names)))
                 ok = False
             elif v.node not in self.support_names:
                 self.problem(where + ("node",), f"node {v.node!r} is not supported; only a "
@@ -119,20 +120,20 @@ class _StepsPass:
         for i, item in enumerate(raw):
             where = ("steps", i)
             kind = item.get("kind")
-            if not isinstance(kind, str) or kind not in _STEP_MODELS:
+            if not isinstance(kind, str) or kind not in STEP_MODELS:
                 if "kind" not in item:
                     self.problem(where + ("kind",), "missing: this key is required (one of "
                                  "'static', 'modal', 'transient')")
                 elif isinstance(kind, str):
-                    self.problem(where + ("kind",), _unknown(kind, "step kind", _STEP_MODELS))
+                    self.problem(where + ("kind",), unknown_word(kind, "step kind", STEP_MODELS))
                 else:
                     self.problem(where + ("kind",), "expected 'static', 'modal' or "
-                                 f"'transient', found {_found(kind)}")
+                                 f"'transient', found {found_text(kind)}")
                 continue
-            model = _STEP_MODELS[kind]
+            model = STEP_MODELS[kind]
             foreign = {
                 key: f"does not apply to a {kind} step (it belongs to {other} steps)"
-                for other, m in _STEP_MODELS.items() if other != kind
+                for other, m in STEP_MODELS.items() if other != kind
                 for key in m.model_fields if key not in model.model_fields
             }
             v, complete = self.validate(model, item, where, foreign)
@@ -144,7 +145,7 @@ class _StepsPass:
                 self.problem(where + ("name",), "a step name names a group of the results "
                              "file: expected a letter, digit or '_' first, then also '.', '-', "
                              "'+', '@' or inner spaces (no '/'; netCDF group names), found "
-                             f"{_short(nm)}")
+                             f"{shorten(nm)}")
             names.setdefault(nm, i)
             if v is None:
                 continue
@@ -164,7 +165,7 @@ class _StepsPass:
                 if not (order == "auto" or (isinstance(order, int) and not isinstance(order, bool)
                                             and 1 <= order <= 5)):
                     self.problem(where + ("max_order",), 'expected "auto" or an integer from 1 '
-                                 f"to 5 (IDA's largest BDF order), found {_found(order)}")
+                                 f"to 5 (IDA's largest BDF order), found {found_text(order)}")
                 extra = {"duration": float(v.duration), "output_interval": float(v.output_interval),
                          "rtol": float(v.rtol), "atol": float(v.atol), "damping": damping,
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
@@ -209,7 +210,7 @@ class _StepsPass:
             return None
         static = [s.name for s in earlier if s.kind == "static"]
         if name not in static:
-            self.problem(where + ("jump_reference",), _unknown(name, "static step before this "
+            self.problem(where + ("jump_reference",), unknown_word(name, "static step before this "
                                                                "one", static))
         return name
 
@@ -223,20 +224,21 @@ class _StepsPass:
                 else "a temperature (the units of reference_temperature)")
         if raw is None:
             return None
-        if _is_number(raw):
+        if is_number(raw):
             return float(raw)
         if not isinstance(raw, dict):
             self.problem(where, f"expected {what} (a number, for every cable) or a table "
-                         f"cable name -> {'K' if change else 'temperature'}, found {_found(raw)}")
+                         f"cable name -> {'K' if change else 'temperature'}, "
+                         f"found {found_text(raw)}")
             return False
         ok = True
         for key, value in raw.items():
             if key not in self.cable_names:
-                self.problem(where + (key,), _unknown(key, "cable", sorted(self.cable_names)))
+                self.problem(where + (key,), unknown_word(key, "cable", sorted(self.cable_names)))
                 ok = False
-            elif not _is_number(value):
+            elif not is_number(value):
                 self.problem(where + (key,), f"expected {what} (a finite number), found "
-                             f"{_found(value)}")
+                             f"{found_text(value)}")
                 ok = False
         return FrozenMap({k: float(v) for k, v in raw.items()}) if ok else False
 
@@ -248,11 +250,11 @@ class _StepsPass:
             self.problem(("steps", 0, "kind"), (
                 f"cable {found[0]!r} has its length found by form-finding, which holds in the "
                 "first step: expected a static step first, found "
-                f"{_found(raw_steps[0].get('kind'))}"))
+                f"{found_text(raw_steps[0].get('kind'))}"))
 
     def add_remove(self, v: Any, where: tuple, step: str, presence: dict) -> None:
         """A step's ``add`` names what is absent before it, its ``remove`` what is present."""
-        here = f"step {step!r} ({_fmt_path(where)})"
+        here = f"step {step!r} ({fmt_path(where)})"
         for key in ("add", "remove"):
             for j, r in enumerate(getattr(v, key)):
                 at = where + (key, j)
@@ -261,7 +263,7 @@ class _StepsPass:
                         self.problem(at, f"{r!r} is the default name of an unnamed distributed "
                                      f'load; give it name = "..." to {key} it')
                     else:
-                        self.problem(at, _unknown(r, "point mass, load or distributed load",
+                        self.problem(at, unknown_word(r, "point mass, load or distributed load",
                                                   sorted(self.removable)))
                     continue
                 if key == "remove" and r in v.add:
@@ -283,7 +285,7 @@ class _StepsPass:
         if raw is None:
             return None
         where = step_where + ("axial_damping",)  # a table: the schema's TomlTable
-        v, complete = self.validate(_AxialDamping, raw, where)
+        v, complete = self.validate(AxialDampingSchema, raw, where)
         if v is None or not complete:
             return None
         f = v.frequency if v.frequency == "element" else float(v.frequency)
@@ -291,7 +293,7 @@ class _StepsPass:
 
     def damping(self, raw: dict, step_where: tuple) -> Damping | None:
         where = step_where + ("damping",)
-        kind, v = self.kinded(raw, where, _DAMPING_MODELS, "damping kind")
+        kind, v = self.kinded(raw, where, DAMPING_MODELS, "damping kind")
         if kind is None:
             return None
         if kind == "material":

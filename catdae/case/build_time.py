@@ -1,5 +1,5 @@
 """Pass 3 for time functions: their kinds, tables and the CSV files behind them. A mixin of
-:class:`~catdae.case.build._Builder`, whose ``problem`` and ``validate`` collect what is
+:class:`~catdae.case.build.Builder`, whose ``problem`` and ``validate`` collect what is
 wrong (see ``build``)."""
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from collections.abc import Mapping
 import numpy as np
 
 from catdae.case.limits import FileProblem, confined, read_limited
-from catdae.case.messages import _found, _short, _suggest, _unknown
+from catdae.case.messages import found_text, shorten, suggest, unknown_word
 from catdae.case.records import AccelerationRecord, VelocityRecord
 from catdae.case.schema import (
-    _TIME_MODELS,
-    _TableTF,
+    TIME_MODELS,
+    TableSchema,
 )
 from catdae.case.timefunc import Constant, Cosine, Ramp, Sine, Table, TimeFunction
 from catdae.case.timefunc_compose import Product, Trapezoid
@@ -26,7 +26,7 @@ _OVERFLOW = ("its value, rate or second derivative overflows (not a finite numbe
              "amplitude against the duration, the frequency or the spacing of the points")
 
 
-class _TimePass:
+class TimePass:
     """Time functions and tables (methods of ``_Builder``)."""
 
     def kind_of(self, raw: dict, where: tuple, models: Mapping, what: str) -> str | None:
@@ -37,9 +37,9 @@ class _TimePass:
             self.problem(where + ("kind",), "missing: this key is required (one of "
                          f"{', '.join(repr(k) for k in models)})")
         elif isinstance(kind, str):
-            self.problem(where + ("kind",), _unknown(kind, what, models))
+            self.problem(where + ("kind",), unknown_word(kind, what, models))
         else:
-            self.problem(where + ("kind",), f"expected a string, found {_found(kind)}")
+            self.problem(where + ("kind",), f"expected a string, found {found_text(kind)}")
         return None
 
     def kinded(self, raw: dict, where: tuple, models: Mapping, what: str):
@@ -55,7 +55,7 @@ class _TimePass:
                       ) -> TimeFunction | None:
         """A time function; ``motion``: it prescribes a support's displacement (a ``table``
         may then be a velocity or acceleration record)."""
-        kind, v = self.kinded(raw, where, _TIME_MODELS, "time function kind")
+        kind, v = self.kinded(raw, where, TIME_MODELS, "time function kind")
         if kind is None:
             return None
         if kind == "constant":
@@ -91,7 +91,7 @@ class _TimePass:
             factors.append(f)
         return Product(tuple(factors))
 
-    def table(self, v: _TableTF, where: tuple, motion: bool = False
+    def table(self, v: TableSchema, where: tuple, motion: bool = False
               ) -> Table | AccelerationRecord | VelocityRecord | None:
         inline = v.t is not None or v.value is not None
         if v.file is not None and inline:
@@ -162,12 +162,12 @@ class _TimePass:
             file = confined(name, self.base_dir)
             raw = read_limited(file, "table file")
         except FileProblem as exc:
-            self.problem(where, f"cannot read table file {_short(name)}: {exc}")
+            self.problem(where, f"cannot read table file {shorten(name)}: {exc}")
             return None
         try:
             text = raw.decode("utf-8")
         except UnicodeDecodeError as exc:
-            self.problem(where, f"cannot read table file {_short(name)}: not UTF-8 text "
+            self.problem(where, f"cannot read table file {shorten(name)}: not UTF-8 text "
                          f"(byte {exc.start})")
             return None
         lines = []
@@ -178,7 +178,7 @@ class _TimePass:
             except StopIteration:
                 break
             except csv.Error as exc:  # a field over the csv module's limit, a stray quote...
-                self.problem(where, f"{_short(name)}, line {reader.line_num}: not readable "
+                self.problem(where, f"{shorten(name)}, line {reader.line_num}: not readable "
                              f"as CSV ({str(exc)[:80]})")
                 return None
             cells = [c.strip() for c in row]
@@ -203,8 +203,8 @@ class _TimePass:
             if column not in header[1:]:
                 listed = _listed(header)
                 hint = (f"{column!r} is the time column" if column == header[0] else
-                        f"{name} has no column {_short(column)}"
-                        f"{_suggest(column, header[1:]) if listed else ''} (its columns: "
+                        f"{name} has no column {shorten(column)}"
+                        f"{suggest(column, header[1:]) if listed else ''} (its columns: "
                         f"{_columns(header)}; time is the first)")
                 self.problem(column_where, hint)
                 return None
@@ -215,12 +215,12 @@ class _TimePass:
             if len(cells) != width or not all(_is_float(c) for c in cells):
                 found = (f"{len(cells)} field(s)" if len(cells) != width
                          else "a field that is not a number")
-                self.problem(where, f"{_short(name)}, line {lineno}: expected {expect}, found "
+                self.problem(where, f"{shorten(name)}, line {lineno}: expected {expect}, found "
                              f"{found}")
                 return None
             pair = (float(cells[0]), float(cells[index]))
             if not all(math.isfinite(float(c)) for c in cells):
-                self.problem(where, f"{_short(name)}, line {lineno}: expected finite numbers, "
+                self.problem(where, f"{shorten(name)}, line {lineno}: expected finite numbers, "
                              "found inf or nan")
                 return None
             rows.append(pair)

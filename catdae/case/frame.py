@@ -10,6 +10,12 @@ possible, from global axes perpendicular to ``ĝ`` (all of them when ``ĝ`` lies
 so that supports fixing only some axes still fix coordinate axes in the rotated frame. A support
 whose fixed axes do not map onto local coordinate axes is rejected by the case validation
 (:func:`local_axes`).
+
+The fluids and the seabed are given in "up" = -ĝ already (heights along up: the still-water
+``surface``, ``depth``, a current profile's ``z``, the wind's ``ground``, the seabed's ``z``;
+headings and wind directions in the plane normal to ``g``, from the first row of ``R`` towards
+the second): those stay as they are in the rotated frame, whose z is that height. Only the
+velocity vectors (current, wind), given in global axes, are rotated.
 """
 
 from __future__ import annotations
@@ -92,9 +98,26 @@ def to_gravity_frame(case: Case) -> tuple[Case, np.ndarray | None]:
         nodes={n: rot(x) for n, x in case.nodes.items()}, supports=supports,
         loads=tuple(replace(ld, force=rot(ld.force)) for ld in case.loads),
         distributed_loads=tuple(replace(d, load=rot(d.load)) for d in case.distributed_loads),
-        support_motions=tuple(motions),
+        support_motions=tuple(motions), water=_water(case.water, rot),
+        air=_air(case.air, rot),
     )
     return local, R
+
+
+def _water(water, rot):
+    """The water in the rotated frame: the current's velocities rotated; its heights (along
+    up), the surface, depth and waves (headings in the frame's x-y plane) as they are."""
+    if water is None or water.current is None:
+        return water
+    cur = water.current
+    return replace(water, current=replace(cur, velocity=tuple(rot(u) for u in cur.velocity)))
+
+
+def _air(air, rot):
+    """The air in the rotated frame: the wind's velocity rotated (its ground is a height)."""
+    if air is None or air.wind is None:
+        return air
+    return replace(air, wind=replace(air.wind, vector=rot(air.wind.vector)))
 
 
 def rotate_back(ds, R: np.ndarray | None):

@@ -1,6 +1,6 @@
 """``[ground]`` of a case: a height, or a ground profile, below the cables, for the clearance
 results (docs/case-format.md, "Line engineering"). A builder pass (a mixin of
-:class:`~catdae.case.build._Builder`) and the frozen :class:`Ground` it makes."""
+:class:`~catdae.case.build.Builder`) and the frozen :class:`Ground` it makes."""
 
 from __future__ import annotations
 
@@ -11,11 +11,11 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
-from catdae.case.schema import _STRICT
+from catdae.case.schema import STRICT
 
 
 class _GroundTable(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     elevation: float | None = None  # m: a level ground (or a height to keep clear of)
     x: list[float] | None = None  # m: a profile, the ground's height z at these x
     z: list[float] | None = None
@@ -37,7 +37,7 @@ class Ground:
         return np.interp(x, self.x, self.z)
 
 
-class _GroundPass:
+class GroundPass:
     """``[ground]`` (methods of ``_Builder``)."""
 
     def ground(self, raw: Any, gravity_direction) -> Ground | None:

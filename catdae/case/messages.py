@@ -12,7 +12,7 @@ _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 MAX_KEY_SHOWN = 60  # characters of one key of a field path in a message
 
 
-def _fmt_path(parts: Iterable[str | int]) -> str:
+def fmt_path(parts: Iterable[str | int]) -> str:
     """``("cables", 0, "length")`` -> ``cables[0].length``; odd keys are quoted."""
     out = ""
     for p in parts:
@@ -27,11 +27,11 @@ def _fmt_path(parts: Iterable[str | int]) -> str:
     return out
 
 
-def _short(s: str, n: int = 40) -> str:
+def shorten(s: str, n: int = 40) -> str:
     return repr(s if len(s) <= n else s[: n - 3] + "...")
 
 
-def _found(v: Any) -> str:
+def found_text(v: Any) -> str:
     """Describe a TOML value in a message: what was found."""
     if v is None:
         return "nothing"
@@ -43,33 +43,33 @@ def _found(v: Any) -> str:
     if isinstance(v, float):
         return f"the number {v!r}"
     if isinstance(v, str):
-        return f"the string {_short(v)}"
+        return f"the string {shorten(v)}"
     if isinstance(v, list | tuple):
         return f"an array of {len(v)} item{'s' if len(v) != 1 else ''}"
     if isinstance(v, Mapping):
-        keys = ", ".join(_short(str(k), 20) for k in list(v)[:5])
+        keys = ", ".join(shorten(str(k), 20) for k in list(v)[:5])
         return f"a table with keys {keys}" if v else "an empty table"
-    return f"a {type(v).__name__} value ({_short(str(v))})"
+    return f"a {type(v).__name__} value ({shorten(str(v))})"
 
 
-def _suggest(word: str, choices: Iterable[str]) -> str:
+def suggest(word: str, choices: Iterable[str]) -> str:
     close = difflib.get_close_matches(word, list(choices), n=1)
     return f"; did you mean {close[0]!r}?" if close else ""
 
 
-def _unknown(word: str, what: str, choices: Iterable[str]) -> str:
+def unknown_word(word: str, what: str, choices: Iterable[str]) -> str:
     choices = list(choices)
-    hint = _suggest(word, choices)
+    hint = suggest(word, choices)
     if not hint:
         hint = (f"; expected one of: {', '.join(repr(c) for c in choices)}" if choices
                 else f"; there is no {what} at all")
-    return f"unknown {what} {_short(word)}{hint}"
+    return f"unknown {what} {shorten(word)}{hint}"
 
 
-def _message(err: dict, fields: Iterable[str], foreign: Mapping[str, str]) -> str:
+def pydantic_message(err: dict, fields: Iterable[str], foreign: Mapping[str, str]) -> str:
     """Turn one pydantic error into 'expected ..., found ...'."""
     typ, inp, ctx = err["type"], err.get("input"), err.get("ctx") or {}
-    found = _found(inp)
+    found = found_text(inp)
     if typ == "missing":
         return "missing: this key is required"
     if typ == "extra_forbidden":
@@ -79,7 +79,7 @@ def _message(err: dict, fields: Iterable[str], foreign: Mapping[str, str]) -> st
         close = difflib.get_close_matches(key, list(fields), n=1)
         hint = (f"; did you mean {close[0]!r}?" if close
                 else f"; expected one of: {', '.join(fields)}")
-        return f"unknown key {_short(key)}{hint}"
+        return f"unknown key {shorten(key)}{hint}"
     simple = {
         "float_type": "a number", "int_type": "an integer", "string_type": "a string",
         "bool_type": "true or false", "list_type": "an array", "dict_type": "a table",
@@ -99,10 +99,10 @@ def _message(err: dict, fields: Iterable[str], foreign: Mapping[str, str]) -> st
     if typ == "literal_error":
         hint = ""
         if isinstance(inp, str):
-            hint = _suggest(inp, re.findall(r"'([^']*)'", str(ctx.get("expected", ""))))
+            hint = suggest(inp, re.findall(r"'([^']*)'", str(ctx.get("expected", ""))))
         return f"expected {ctx.get('expected')}, found {found}{hint}"
     return f"{err.get('msg', 'invalid value')}, found {found}"
 
 
-def _is_number(v: Any) -> bool:
+def is_number(v: Any) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)

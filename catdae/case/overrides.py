@@ -1,6 +1,6 @@
 """Settings a command line (or ``catdae.run``'s keywords) replaces in a case: ``rtol``,
 ``atol``, ``mass_model`` and ``elements``, validated by the case file's own schema types
-(``schema._Overrides``), with what sits on mesh nodes kept in place on a new mesh."""
+(``schema.OverridesSchema``), with what sits on mesh nodes kept in place on a new mesh."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ from dataclasses import replace
 from pydantic import ValidationError
 
 from catdae.case.limits import size_problems
-from catdae.case.messages import _message
+from catdae.case.messages import pydantic_message
 from catdae.case.model import Case
 from catdae.case.names import mesh_node, split_mesh_node
-from catdae.case.schema import _Overrides
+from catdae.case.schema import OverridesSchema
 from catdae.errors import CaseError
 
 
@@ -31,10 +31,10 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
              "elements": (int(elements) if isinstance(elements, numbers.Integral)
                           and not isinstance(elements, bool) else elements)}
     try:
-        _Overrides.model_validate({k: v for k, v in given.items() if v is not None})
+        OverridesSchema.model_validate({k: v for k, v in given.items() if v is not None})
     except ValidationError as exc:
-        fields = list(_Overrides.model_fields)
-        raise CaseError(self.path, [(str(err["loc"][0]), _message(err, fields, {}))
+        fields = list(OverridesSchema.model_fields)
+        raise CaseError(self.path, [(str(err["loc"][0]), pydantic_message(err, fields, {}))
                                     for err in exc.errors()]) from None
     steps = tuple(
         replace(s, rtol=float(rtol if rtol is not None else s.rtol),

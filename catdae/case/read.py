@@ -9,9 +9,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from catdae.case.build import _Builder
+from catdae.case.build import Builder
 from catdae.case.limits import FileProblem, key_depth_problem, read_limited
-from catdae.case.messages import _found
+from catdae.case.messages import found_text
 from catdae.case.model import Case
 from catdae.errors import CaseError
 
@@ -68,8 +68,8 @@ def case_from_dict(data: Mapping[str, Any], *, path: str | None = None, text: st
     ``base_dir`` resolves ``table`` files (default: the current directory).
     """
     if not isinstance(data, Mapping):
-        raise CaseError(path, [("", f"expected a table of keys, found {_found(data)}")])
-    builder = _Builder(path, Path(base_dir) if base_dir is not None else Path.cwd())
+        raise CaseError(path, [("", f"expected a table of keys, found {found_text(data)}")])
+    builder = Builder(path, Path(base_dir) if base_dir is not None else Path.cwd())
     return builder.build(dict(data), text=text, name=name)
 
 

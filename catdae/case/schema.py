@@ -11,9 +11,9 @@ from typing import Annotated, Any, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
-from catdae.case.limits import MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
+from catdae.case.limits import MAX_COORDINATE, MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
 
-_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
 Pos = Annotated[float, Field(gt=0)]
 NonNeg = Annotated[float, Field(ge=0)]
@@ -21,15 +21,15 @@ Time = Annotated[float, Field(ge=MIN_TIME)]  # s: shorter is degenerate (0/0 in 
 Frequency = Annotated[float, Field(gt=0, le=MAX_FREQUENCY)]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Name = Annotated[str, Field(min_length=1)]
-# settings a command line may override too (``_Overrides``): one type for both
+# settings a command line may override too (``OverridesSchema``): one type for both
 Elements = Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)]
 MassModelName = Literal["auto", "blended", "consistent", "lumped", "linear"]
 MASS_MODEL_NAMES = get_args(MassModelName)
 TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
 
 
-class _Top(BaseModel):
-    model_config = _STRICT
+class TopSchema(BaseModel):
+    model_config = STRICT
     title: str = ""
     source: str = ""
     gravity: Any = 9.81  # a number (along -z) or [gx, gy, gz]: checked by the builder
@@ -52,8 +52,8 @@ class _Top(BaseModel):
     ground: TomlTable | None = None  # catdae.case.ground
 
 
-class _Material(BaseModel):
-    model_config = _STRICT
+class MaterialSchema(BaseModel):
+    model_config = STRICT
     EA: Pos
     mass: NonNeg
     weight: NonNeg | None = None
@@ -68,8 +68,8 @@ class _Material(BaseModel):
     rated_strength: Pos | None = None  # N, optional
 
 
-class _Cable(BaseModel):
-    model_config = _STRICT
+class CableSchema(BaseModel):
+    model_config = STRICT
     name: Name
     ends: Annotated[list[Name], Field(min_length=2, max_length=2)]
     material: Name
@@ -79,8 +79,8 @@ class _Cable(BaseModel):
     gauss_points: Annotated[int, Field(ge=1, le=10)] = 3
 
 
-class _PointMass(BaseModel):
-    model_config = _STRICT
+class PointMassSchema(BaseModel):
+    model_config = STRICT
     name: Name
     mass: Pos
     node: Name | None = None
@@ -89,8 +89,8 @@ class _PointMass(BaseModel):
     active: bool = True
 
 
-class _Load(BaseModel):
-    model_config = _STRICT
+class LoadSchema(BaseModel):
+    model_config = STRICT
     name: Name
     force: Vec3
     node: Name | None = None
@@ -100,8 +100,8 @@ class _Load(BaseModel):
     active: bool = True
 
 
-class _DistributedLoad(BaseModel):
-    model_config = _STRICT
+class DistributedLoadSchema(BaseModel):
+    model_config = STRICT
     name: Name | None = None
     cable: Name
     load: Vec3
@@ -111,8 +111,8 @@ class _DistributedLoad(BaseModel):
     active: bool = True
 
 
-class _SupportMotion(BaseModel):
-    model_config = _STRICT
+class SupportMotionSchema(BaseModel):
+    model_config = STRICT
     node: Name
     x: TomlTable | None = None
     y: TomlTable | None = None
@@ -122,7 +122,7 @@ class _SupportMotion(BaseModel):
 
 
 class _StaticStep(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["static"]
     name: Name | None = None
     remove: list[Name] = []
@@ -134,7 +134,7 @@ class _StaticStep(BaseModel):
 
 
 class _ModalStep(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["modal"]
     name: Name | None = None
     remove: list[Name] = []
@@ -148,7 +148,7 @@ class _ModalStep(BaseModel):
 
 
 class _TransientStep(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["transient"]
     name: Name | None = None
     remove: list[Name] = []
@@ -169,10 +169,10 @@ class _TransientStep(BaseModel):
     axial_damping: TomlTable | None = None
 
 
-class _Form(BaseModel):
+class FormSchema(BaseModel):
     """``form = { ... }`` of a cable: exactly one target (the builder checks which)."""
 
-    model_config = _STRICT
+    model_config = STRICT
     pretension: Pos | None = None
     horizontal_tension: Pos | None = None
     tension: Pos | None = None
@@ -182,18 +182,18 @@ class _Form(BaseModel):
 
 FORM_TARGETS = ("pretension", "horizontal_tension", "tension", "sag")
 
-_STEP_MODELS: dict[str, type[BaseModel]] = {
+STEP_MODELS: dict[str, type[BaseModel]] = {
     "static": _StaticStep, "modal": _ModalStep, "transient": _TransientStep,
 }
 
 
 class _MaterialDamping(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["material"]
 
 
 class _RayleighDamping(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["rayleigh"]
     alpha: NonNeg | None = None
     beta: NonNeg | None = None
@@ -201,27 +201,27 @@ class _RayleighDamping(BaseModel):
     frequencies: Annotated[list[Pos], Field(min_length=2, max_length=2)] | None = None
 
 
-class _AxialDamping(BaseModel):
+class AxialDampingSchema(BaseModel):
     """``axial_damping = { ratio = .., frequency = .. }`` of a transient step."""
 
-    model_config = _STRICT
+    model_config = STRICT
     ratio: Pos
     frequency: Pos | Literal["element"] = "element"
 
 
-_DAMPING_MODELS: dict[str, type[BaseModel]] = {
+DAMPING_MODELS: dict[str, type[BaseModel]] = {
     "material": _MaterialDamping, "rayleigh": _RayleighDamping,
 }
 
 
 class _ConstantTF(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["constant"]
     value: float
 
 
 class _RampTF(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["ramp"]
     duration: Time
     start: float = 0.0
@@ -230,7 +230,7 @@ class _RampTF(BaseModel):
 
 
 class _SineTF(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["sine", "cosine"]
     amplitude: float
     frequency: Frequency
@@ -238,8 +238,8 @@ class _SineTF(BaseModel):
     offset: float = 0.0
 
 
-class _TableTF(BaseModel):
-    model_config = _STRICT
+class TableSchema(BaseModel):
+    model_config = STRICT
     kind: Literal["table"]
     file: Name | None = None
     t: list[float] | None = None
@@ -249,13 +249,13 @@ class _TableTF(BaseModel):
 
 
 class _ProductTF(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["product"]
     factors: list[TomlTable]  # time functions, multiplied (at least 2: the builder)
 
 
 class _TrapezoidTF(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     kind: Literal["trapezoid"]
     rise: Time
     hold: NonNeg = 0.0
@@ -265,19 +265,22 @@ class _TrapezoidTF(BaseModel):
     smooth: bool = False
 
 
-_TIME_MODELS: dict[str, type[BaseModel]] = {
+TIME_MODELS: dict[str, type[BaseModel]] = {
     "constant": _ConstantTF, "ramp": _RampTF, "sine": _SineTF, "cosine": _SineTF,
-    "table": _TableTF, "product": _ProductTF, "trapezoid": _TrapezoidTF,
+    "table": TableSchema, "product": _ProductTF, "trapezoid": _TrapezoidTF,
 }
 
-_VEC3 = TypeAdapter(Vec3, config=ConfigDict(strict=True, allow_inf_nan=False))
+VEC3 = TypeAdapter(Vec3, config=ConfigDict(strict=True, allow_inf_nan=False))
+Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+POSITION = TypeAdapter(Annotated[list[Coordinate], Field(min_length=3, max_length=3)],
+                       config=ConfigDict(strict=True, allow_inf_nan=False))
 
 
-class _Overrides(BaseModel):
+class OverridesSchema(BaseModel):
     """What ``catdae run --rtol/--atol/--elements/--mass-model`` (and the keywords of
     ``catdae.run``) may replace, typed as the case file's own fields."""
 
-    model_config = _STRICT
+    model_config = STRICT
     rtol: Pos | None = None  # as a transient step's rtol
     atol: Pos | None = None  # as a transient step's atol
     elements: Elements | None = None  # as a cable's elements

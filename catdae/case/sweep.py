@@ -18,7 +18,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-from catdae.case.messages import _found, _is_number, _unknown
+from catdae.case.messages import found_text, is_number, unknown_word
 
 # field of a connector section -> (lowest value, whether the lowest is allowed)
 _CONNECTOR_FIELDS = {
@@ -37,7 +37,7 @@ class Sweep:
     values: tuple[float, ...]
 
 
-class _SweepPass:
+class SweepPass:
     """A step's ``sweep`` (a method of ``_Builder``)."""
 
     def sweep(self, raw: Any, where: tuple, connectors: dict) -> Sweep | None | bool:
@@ -47,18 +47,18 @@ class _SweepPass:
         where = where + ("sweep",)
         if not isinstance(raw, dict):
             self.problem(where, 'expected a table { field = "...", values = [...] }, found '
-                         f"{_found(raw)}")
+                         f"{found_text(raw)}")
             return False
         extra = sorted(set(raw) - {"field", "values"})
         for key in extra:
-            self.problem(where + (key,), _unknown(key, "key", ["field", "values"]))
+            self.problem(where + (key,), unknown_word(key, "key", ["field", "values"]))
         field, values = raw.get("field"), raw.get("values")
         ok = not extra
         fields = list(_STEP_FIELDS) + [f"{s}.<name>.{f}" for s, fs in
                                         _CONNECTOR_FIELDS.items() for f in fs]
         low = None
         if not isinstance(field, str):
-            self.problem(where + ("field",), f"expected one of {fields}, found {_found(field)}")
+            self.problem(where + ("field",), f"expected one of {fields}, found {found_text(field)}")
             ok = False
         elif field not in _STEP_FIELDS:
             section, _, rest = field.partition(".")
@@ -66,16 +66,16 @@ class _SweepPass:
             names = {x.name for x in connectors.get(section, ())}
             if section not in _CONNECTOR_FIELDS or attr not in _CONNECTOR_FIELDS[section]:
                 self.problem(where + ("field",), f"expected one of {fields}, found "
-                             f"{_found(field)}")
+                             f"{found_text(field)}")
                 ok = False
             elif name not in names:
-                self.problem(where + ("field",), _unknown(name, section[:-1], sorted(names)))
+                self.problem(where + ("field",), unknown_word(name, section[:-1], sorted(names)))
                 ok = False
             else:
                 low = _CONNECTOR_FIELDS[section][attr]
-        if not (isinstance(values, list) and values and all(_is_number(v) for v in values)):
+        if not (isinstance(values, list) and values and all(is_number(v) for v in values)):
             self.problem(where + ("values",), "expected a non-empty list of finite numbers, "
-                         f"found {_found(values)}")
+                         f"found {found_text(values)}")
             return False
         if low is not None:
             bound, inclusive = low
@@ -83,7 +83,7 @@ class _SweepPass:
                 if v < bound or (v == bound and not inclusive):
                     self.problem(where + ("values", k), f"expected a value "
                                  f"{'>=' if inclusive else '>'} {bound:g} for {field}, found "
-                                 f"{_found(v)}")
+                                 f"{found_text(v)}")
                     ok = False
         return Sweep(field, tuple(float(v) for v in values)) if ok else False
 

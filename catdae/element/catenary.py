@@ -59,7 +59,7 @@ STATUS_NAMES = {CONVERGED: "converged", SLACK: "slack", NOT_CONVERGED: "not conv
 # compiled kernels
 # ----------------------------------------------------------------------------------------------
 @njit(cache=True, inline="always")
-def _asinhc(z):
+def asinhc(z):
     """asinh(z)/z, stable at z -> 0."""
     az = abs(z)
     if az < 1e-3:
@@ -69,7 +69,7 @@ def _asinhc(z):
 
 
 @njit(cache=True, inline="always")
-def _segment(hx, hy, v, w, ea, a, b, d, f, want_flex):
+def segment(hx, hy, v, w, ea, a, b, d, f, want_flex):
     """Add the chord (and flexibility) of the load-free stretch [a, b] to d (3,) and f (6,).
 
     f holds the upper triangle (xx, xy, xz, yy, yz, zz). docs/theory.md §2-3 in the stable
@@ -92,7 +92,7 @@ def _segment(hx, hy, v, w, ea, a, b, d, f, want_flex):
         return False
     r = (ta + tb) / s_
     le = ell / ea
-    p = ell * r * _asinhc(w * ell * r)  # ∫ ds/T
+    p = ell * r * asinhc(w * ell * r)  # ∫ ds/T
     d[0] += hx * (le + p)
     d[1] += hy * (le + p)
     d[2] += 0.5 * ell * (ua + ub) * (1.0 / ea + 2.0 / (ta + tb))
@@ -109,7 +109,7 @@ def _segment(hx, hy, v, w, ea, a, b, d, f, want_flex):
 
 
 @njit(cache=True)
-def _partial(h0, h1, h2, w, ea, s_end, ls, lf, k0, k1, d, f, want_flex):
+def partial_solution(h0, h1, h2, w, ea, s_end, ls, lf, k0, k1, d, f, want_flex):
     """Position x(s_end) relative to node i (into d) and G(s_end) (into f, upper triangle).
 
     Loads k0..k1-1 (sorted by s) act on the element; a load at s_k changes t for s > s_k.
@@ -126,18 +126,18 @@ def _partial(h0, h1, h2, w, ea, s_end, ls, lf, k0, k1, d, f, want_flex):
         if sk >= s_end:
             break
         if sk > a:
-            ok = _segment(hx, hy, v, w, ea, a, sk, d, f, want_flex) and ok
+            ok = segment(hx, hy, v, w, ea, a, sk, d, f, want_flex) and ok
             a = sk
         hx -= lf[k, 0]
         hy -= lf[k, 1]
         v -= lf[k, 2]
     if s_end > a:
-        ok = _segment(hx, hy, v, w, ea, a, s_end, d, f, want_flex) and ok
+        ok = segment(hx, hy, v, w, ea, a, s_end, d, f, want_flex) and ok
     return ok
 
 
 @njit(cache=True, inline="always")
-def _inv_sym3(f, kout):
+def inv_sym3(f, kout):
     """Inverse of the symmetric 3x3 matrix with upper triangle f (6,), into kout (3, 3)."""
     a, b, c, d, e, g = f[0], f[1], f[2], f[3], f[4], f[5]
     c00 = d * g - e * e
@@ -230,7 +230,7 @@ def _steep_start(c, l0, ea, w, lh, h):
         v = (lz - l0 - half * l0 / ea) / (2.0 / w + l0 / ea)
     d = np.empty(3)
     f = np.empty(6)
-    ok = _partial(0.0, 0.0, v, w, ea, l0, np.empty(0), np.empty((0, 3)), 0, 0, d, f, True)
+    ok = partial_solution(0.0, 0.0, v, w, ea, l0, np.empty(0), np.empty((0, 3)), 0, 0, d, f, True)
     if ok and np.isfinite(f[0]) and f[0] > 0.0:
         h[0] = c[0] / f[0]
         h[1] = c[1] / f[0]
@@ -242,7 +242,7 @@ def _steep_start(c, l0, ea, w, lh, h):
 
 
 @njit(cache=True)
-def _solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout):
+def solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout):
     """Newton for one element, warm-started from ``h`` when ``use_h``; a warm start that
     fails (e.g. from a folded vertical state to a taut one) is retried cold."""
     it, status = _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout)
@@ -279,11 +279,11 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
     rscale = max(l0, lc)
     if not use_h:
         _cold_start(c, l0, ea, w, ls, lf, k0, k1, h)
-    ok = _partial(h[0], h[1], h[2], w, ea, l0, ls, lf, k0, k1, d, f, True)
+    ok = partial_solution(h[0], h[1], h[2], w, ea, l0, ls, lf, k0, k1, d, f, True)
     if not ok:
         # a start on a point of zero tension: nudge it
         h[2] += 1e-9 * (hscale_extra + ea * 1e-9)
-        ok = _partial(h[0], h[1], h[2], w, ea, l0, ls, lf, k0, k1, d, f, True)
+        ok = partial_solution(h[0], h[1], h[2], w, ea, l0, ls, lf, k0, k1, d, f, True)
     rn = 0.0
     for m in range(3):
         d[m] -= c[m]
@@ -295,7 +295,7 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
         status = CONVERGED
     while status != CONVERGED and it < max_iter and ok:
         it += 1
-        if not _inv_sym3(f, kk):
+        if not inv_sym3(f, kk):
             break
         hn = 0.0
         dn = 0.0
@@ -309,7 +309,7 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
             # the Newton correction is below the requested accuracy: take it and stop
             for m in range(3):
                 ht[m] = h[m] + dh[m]
-            if _partial(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True):
+            if partial_solution(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True):
                 for m in range(3):
                     h[m] = ht[m]
                 for m in range(6):
@@ -321,7 +321,7 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
         for _ in range(36):
             for m in range(3):
                 ht[m] = h[m] + alpha * dh[m]
-            okt = _partial(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True)
+            okt = partial_solution(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True)
             rt = 0.0
             for m in range(3):
                 dt[m] -= c[m]
@@ -364,7 +364,7 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
             return it, SLACK
     for m in range(6):
         fout[m] = f[m]
-    if not _inv_sym3(f, kout):
+    if not inv_sym3(f, kout):
         kout[:, :] = 0.0
         if status == CONVERGED:
             status = NOT_CONVERGED

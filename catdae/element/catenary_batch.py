@@ -7,32 +7,32 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import _partial, _solve_one
+from catdae.element.catenary import partial_solution, solve_one
 
 
 @njit(cache=True)
-def _solve_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, fflat, kmat, its, stat):
+def solve_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, fflat, kmat, its, stat):
     for e in range(chord.shape[0]):
-        its[e], stat[e] = _solve_one(
+        its[e], stat[e] = solve_one(
             chord[e], l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h[e], use_h, tol,
             max_iter, fflat[e], kmat[e],
         )
 
 
 @njit(cache=True)
-def _partial_batch(h, l0, ea, w, ptr, ls, lf, s, xout, gout, want_flex):
+def partial_batch(h, l0, ea, w, ptr, ls, lf, s, xout, gout, want_flex):
     """x(s) and G(s) at s (n, q) for every element: xout (n, q, 3), gout (n, q, 6)."""
     ok_all = True
     for e in range(h.shape[0]):
         for j in range(s.shape[1]):
-            ok = _partial(h[e, 0], h[e, 1], h[e, 2], w[e], ea[e], s[e, j], ls, lf, ptr[e],
+            ok = partial_solution(h[e, 0], h[e, 1], h[e, 2], w[e], ea[e], s[e, j], ls, lf, ptr[e],
                           ptr[e + 1], xout[e, j], gout[e, j], want_flex)
             ok_all = ok_all and ok
     return ok_all
 
 
 @njit(cache=True)
-def _energy_batch(h, l0, ea, w, ptr, ls, lf, xi, wi, out):
+def energy_batch(h, l0, ea, w, ptr, ls, lf, xi, wi, out):
     """Per element, out[e, 0]: strain energy ∫ T²/(2 EA) ds, exact (T² is a quadratic in s
     between the loads); out[e, 1]: ∫ w (z(s) - z_i) ds by the Gauss points xi, wi (on [-1, 1])
     on each smooth piece between the loads."""
@@ -61,7 +61,7 @@ def _energy_batch(h, l0, ea, w, ptr, ls, lf, xi, wi, out):
             if b > a and we != 0.0:
                 for j in range(xi.shape[0]):
                     sj = a + 0.5 * (xi[j] + 1.0) * (b - a)
-                    _partial(h[e, 0], h[e, 1], h[e, 2], we, ea[e], sj, ls, lf, ptr[e],
+                    partial_solution(h[e, 0], h[e, 1], h[e, 2], we, ea[e], sj, ls, lf, ptr[e],
                              ptr[e + 1], d, f, False)
                     g += 0.5 * wi[j] * (b - a) * we * d[2]
                 a = b
@@ -69,7 +69,7 @@ def _energy_batch(h, l0, ea, w, ptr, ls, lf, xi, wi, out):
 
 
 @njit(cache=True)
-def _tension_batch(h, w, ptr, ls, lf, s, tout):
+def tension_batch(h, w, ptr, ls, lf, s, tout):
     """Tension vector t(s) (n, q, 3); loads at s_k act for s > s_k."""
     for e in range(h.shape[0]):
         for j in range(s.shape[1]):

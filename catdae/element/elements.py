@@ -18,20 +18,20 @@ from catdae.element.catenary import (  # noqa: F401  (re-exported)
     STATUS_NAMES,
 )
 from catdae.element.catenary_batch import (  # noqa: F401  (re-exported)
-    _energy_batch,
-    _partial_batch,
-    _solve_batch,
-    _tension_batch,
+    energy_batch,
+    partial_batch,
+    solve_batch,
+    tension_batch,
 )
 from catdae.element.mass import (  # noqa: F401  (re-exported)
-    _dynamic_forces,
-    _dynamics_batch,
-    _mass_batch,
-    _mass_gradient_batch,
+    dynamic_forces,
+    dynamics_batch,
+    mass_batch,
+    mass_gradient_batch,
 )
 
 
-def _sym_from_upper(f6: np.ndarray) -> np.ndarray:
+def sym_from_upper(f6: np.ndarray) -> np.ndarray:
     """(..., 6) upper triangles -> (..., 3, 3) symmetric matrices."""
     out = np.empty(f6.shape[:-1] + (3, 3))
     out[..., 0, 0] = f6[..., 0]
@@ -166,9 +166,9 @@ class Elements:
         kmat = np.empty((self.n, 3, 3))
         its = np.empty(self.n, np.int64)
         stat = np.empty(self.n, np.int64)
-        _solve_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, h, use_h,
+        solve_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, h, use_h,
                      tol, max_iter, f6, kmat, its, stat)
-        return ElementState(h, _sym_from_upper(f6), kmat, its, stat)
+        return ElementState(h, sym_from_upper(f6), kmat, its, stat)
 
     def solve_dynamic(self, chord, h0, gauss_s, gauss_w, m, c=None, point_masses=None,
                       *, tol: float = 1e-12, max_iter: int = 100, gradient: bool = False):
@@ -196,10 +196,10 @@ class Elements:
         gw = np.ascontiguousarray(gauss_w, float)
         mq = np.ascontiguousarray(m, float)
         dm = np.empty((self.n, 3, 6, 6)) if gradient else np.empty((1, 3, 6, 6))
-        _dynamics_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, h,
+        dynamics_batch(chord, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, h,
                         use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm, want_c,
                         gradient, f6, kmat, its, stat, me, ce, dm)
-        state = ElementState(h, _sym_from_upper(f6), kmat, its, stat)
+        state = ElementState(h, sym_from_upper(f6), kmat, its, stat)
         self._last_dynamic = (gs, gw, mq, pmptr, pms, pmm)
         if gradient:
             return state, me, (ce if want_c else None), dm
@@ -214,7 +214,7 @@ class Elements:
         """
         pmptr, pms, pmm = self._point_mass_csr(point_masses)
         out = np.empty((self.n, 6, 6))
-        _mass_batch(np.ascontiguousarray(state.h, float), np.ascontiguousarray(state.K, float),
+        mass_batch(np.ascontiguousarray(state.h, float), np.ascontiguousarray(state.K, float),
                     np.ascontiguousarray(state.status, np.int64), self.L0, self.EA, self.w,
                     self._ptr, self._ls, self._lf, np.ascontiguousarray(gauss_s, float),
                     np.ascontiguousarray(gauss_w, float),
@@ -226,7 +226,7 @@ class Elements:
         and point masses)."""
         gs, gw, mq, pmptr, pms, pmm = self._last_dynamic
         out = np.empty((self.n, 3, 6, 6))
-        _mass_gradient_batch(self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, state.h,
+        mass_gradient_batch(self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, state.h,
                              state.K, state.status, gs, gw, mq, pmptr, pms, pmm, out)
         return out
 
@@ -253,7 +253,7 @@ class Elements:
         s = self._s(s)
         x = np.empty(s.shape + (3,))
         g = np.empty(s.shape + (6,))
-        _partial_batch(h, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, s, x, g,
+        partial_batch(h, self.L0, self.EA, self.w, self._ptr, self._ls, self._lf, s, x, g,
                        want_flex)
         return x, g
 
@@ -263,7 +263,7 @@ class Elements:
 
     def flexibility(self, h) -> np.ndarray:
         """F(h) = ∂ℓ/∂h, (n, 3, 3) m/N (§3)."""
-        return _sym_from_upper(self._partial(h, self.L0[:, None], True)[1][:, 0])
+        return sym_from_upper(self._partial(h, self.L0[:, None], True)[1][:, 0])
 
     def position(self, h, s) -> np.ndarray:
         """x(s) - x_i for s (n, q) or (q,), returns (n, q, 3) m."""
@@ -271,13 +271,13 @@ class Elements:
 
     def partial_flexibility(self, h, s) -> np.ndarray:
         """G(s) = ∂x(s)/∂h, (n, q, 3, 3) m/N (§6)."""
-        return _sym_from_upper(self._partial(h, s, True)[1])
+        return sym_from_upper(self._partial(h, s, True)[1])
 
     def tension_vector(self, h, s) -> np.ndarray:
         """t(s), (n, q, 3) N; at a load position the value just before the load."""
         s = self._s(s)
         out = np.empty(s.shape + (3,))
-        _tension_batch(self._h(h), self.w, self._ptr, self._ls, self._lf, s, out)
+        tension_batch(self._h(h), self.w, self._ptr, self._ls, self._lf, s, out)
         return out
 
     def tension(self, h, s) -> np.ndarray:
@@ -298,7 +298,7 @@ class Elements:
         """Per element (n, 2): the strain energy ∫ T²/(2 EA) ds (exact) and ∫ w (z(s) - z_i) ds
         (Gauss points xi, weights wi on [-1, 1], on each piece between loads), J."""
         out = np.empty((self.n, 2))
-        _energy_batch(self._h(h), self.L0, self.EA, self.w, self._ptr, self._ls, self._lf,
+        energy_batch(self._h(h), self.L0, self.EA, self.w, self._ptr, self._ls, self._lf,
                       np.ascontiguousarray(xi, float), np.ascontiguousarray(wi, float), out)
         return out
 

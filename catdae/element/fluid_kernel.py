@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.fluid_kinematics import _profile, surface_elevation, wave_kinematics
+from catdae.element.fluid_kinematics import profile, surface_elevation, wave_kinematics
 
 
 @njit(cache=True)
@@ -198,8 +198,7 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                     if has_waves:
                         wave_kinematics(xg[0], xg[1], xg[2], t, surface, depth, amp, omega,
                                         wk, cosb, sinb, phase, ramp, dramp, uf, af, gu, ga)
-                    _profile(c_kind, xg[2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur,
-                             du)
+                    profile(c_kind, xg[2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur, du)
                     if has_waves:
                         for a in range(3):
                             uf[a] += c_fac * ur[a]
@@ -211,8 +210,8 @@ def fluid_pass(X, V, A, conn, l0, gs, gw, area, diam, cdn, cda, can, caa, in_wei
                                 gu[a, b] = 0.0
                             gu[a, 2] = c_fac * du[a]
                 else:
-                    _profile(a_kind, xg[2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
-                             a_ground, uf, du)
+                    profile(a_kind, xg[2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
+                            a_ground, uf, du)
                     for a in range(3):
                         uf[a] *= a_fac
                         for b in range(3):

@@ -12,7 +12,7 @@ NONE, UNIFORM, PROFILE, POWER, LOG = 0, 1, 2, 3, 4
 
 
 @njit(cache=True, inline="always")
-def _profile(kind, z, vec, zs, vs, speed, direction, expo, z_ref, ground, u, du):
+def profile(kind, z, vec, zs, vs, speed, direction, expo, z_ref, ground, u, du):
     """Velocity u (3,) and its derivative along z du (3,) of a current or wind at height z."""
     for a in range(3):
         u[a] = 0.0
@@ -180,11 +180,11 @@ def point_kinematics(pts, t, rho_w, surface, depth, c_kind, c_vec, c_z, c_v, c_f
                                   omega, wk, cosb, sinb, phase, ramp, dramp, u, a, gu, ga)
         eta_out[p] = eta
         if rho_w > 0.0 and pts[p, 2] <= surface + eta:
-            _profile(c_kind, pts[p, 2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur, du)
+            profile(c_kind, pts[p, 2], c_vec, c_z, c_v, 0.0, c_vec, 0.0, 1.0, 0.0, ur, du)
             for k in range(3):
                 vel_out[p, k] = u[k] + c_fac * ur[k]
         elif rho_a > 0.0:
-            _profile(a_kind, pts[p, 2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
+            profile(a_kind, pts[p, 2], a_vec, c_z, c_v, a_speed, a_dir, a_expo, a_zref,
                      a_ground, ur, du)
             for k in range(3):
                 vel_out[p, k] = a_fac * ur[k]

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, _inv_sym3, _segment
+from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, inv_sym3, segment
 
 FREE = 0
 AT_I = 1
@@ -67,9 +67,9 @@ def chord_grounded(hx, hy, v, w, ea, l0, mode, d, f, want_flex):
     s_star = min(max(-v / w, 0.0), l0)
     if mode == AT_I:
         ok = _lying(hx, hy, ea, s_star, d, f, want_flex)
-        ok = _segment(hx, hy, v, w, ea, s_star, l0, d, f, want_flex) and ok
+        ok = segment(hx, hy, v, w, ea, s_star, l0, d, f, want_flex) and ok
     else:
-        ok = _segment(hx, hy, v, w, ea, 0.0, s_star, d, f, want_flex)
+        ok = segment(hx, hy, v, w, ea, 0.0, s_star, d, f, want_flex)
         ok = _lying(hx, hy, ea, l0 - s_star, d, f, want_flex) and ok
     return ok
 
@@ -169,7 +169,7 @@ def solve_grounded(c, l0, ea, w, mode, h, use_h, tol, max_iter, fout, kout):
             status = CONVERGED
             break
         it += 1
-        if not _inv_sym3(f, kk):
+        if not inv_sym3(f, kk):
             break
         hn = 0.0
         dn = 0.0
@@ -210,7 +210,7 @@ def solve_grounded(c, l0, ea, w, mode, h, use_h, tol, max_iter, fout, kout):
             break
     for m in range(6):
         fout[m] = f[m]
-    if not _inv_sym3(f, kout):
+    if not inv_sym3(f, kout):
         kout[:, :] = 0.0
         status = NOT_CONVERGED
     return it, status
@@ -259,9 +259,9 @@ def _position_one(hx, hy, v, w, ea, l0, mode, s, d, f):
     if mode == AT_I:
         _lying(hx, hy, ea, min(s, s_star), d, f, False)
         if s > s_star:
-            _segment(hx, hy, v, w, ea, s_star, s, d, f, False)
+            segment(hx, hy, v, w, ea, s_star, s, d, f, False)
     else:
-        _segment(hx, hy, v, w, ea, 0.0, min(s, s_star), d, f, False)
+        segment(hx, hy, v, w, ea, 0.0, min(s, s_star), d, f, False)
         if s > s_star:
             _lying(hx, hy, ea, s - s_star, d, f, False)
 

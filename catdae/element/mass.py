@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import CONVERGED, SLACK, _inv_sym3, _partial, _solve_one
-from catdae.element.mass_gradient import _gradient_fade, _mass_grad_one
+from catdae.element.catenary import CONVERGED, SLACK, inv_sym3, partial_solution, solve_one
+from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 
 
 @njit(cache=True, inline="always")
@@ -54,29 +54,29 @@ def _mass_one(he, kk, slack, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0
         if wt == 0.0:
             continue
         if not slack:
-            _partial(he[0], he[1], he[2], w, ea, gs_e[j], ls, lf, k0, k1, x, g6, True)
+            partial_solution(he[0], he[1], he[2], w, ea, gs_e[j], ls, lf, k0, k1, x, g6, True)
         _add_ntn(g6, kk, gs_e[j] / l0, slack, scale_e * l0 * wt, out)
     if with_points:
         for p in range(pm0, pm1):
             if not slack:
-                _partial(he[0], he[1], he[2], w, ea, pms[p], ls, lf, k0, k1, x, g6, True)
+                partial_solution(he[0], he[1], he[2], w, ea, pms[p], ls, lf, k0, k1, x, g6, True)
             _add_ntn(g6, kk, pms[p] / l0, slack, pmm[p], out)
 
 
 @njit(cache=True)
-def _dynamics_work():
-    """Work arrays of ``_dynamics_one``: x, g6, fg, dkk, gm, bm, fm, nm, dn."""
+def dynamics_work():
+    """Work arrays of ``dynamics_one``: x, g6, fg, dkk, gm, bm, fm, nm, dn."""
     return (np.empty(3), np.empty(6), np.empty((6, 3)), np.empty((3, 3, 3)), np.empty((3, 3)),
             np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 6)), np.empty((3, 6)))
 
 
 @njit(cache=True)
-def _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
+def dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
                   pmptr, pms, pmm, want_m, want_c, want_dm, fflat, kmat, its, stat, mout, cout,
                   dout, x, g6, fg, dkk, gm, bm, fm, nm, dn):
-    """Element e of ``_dynamics_batch`` (work arrays from the caller); with ``want_m`` False
+    """Element e of ``dynamics_batch`` (work arrays from the caller); with ``want_m`` False
     only the solve (a lumped or constant mass)."""
-    its[e], stat[e] = _solve_one(
+    its[e], stat[e] = solve_one(
         chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h[e], use_h, tol,
         max_iter, fflat[e], kmat[e],
     )
@@ -87,9 +87,9 @@ def _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs,
     if want_dm:
         fade = 0.0
         if stat[e] == CONVERGED:
-            fade = _gradient_fade(h[e], w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])
+            fade = gradient_fade(h[e], w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])
         if fade > 0.0:
-            done = _mass_grad_one(h[e], kmat[e], l0[e], ea[e], w[e], ls, lf, ptr[e],
+            done = mass_grad_one(h[e], kmat[e], l0[e], ea[e], w[e], ls, lf, ptr[e],
                                   ptr[e + 1], gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1],
                                   pms, pmm, fade, mout[e], dout[e], g6, fg, dkk, gm, bm,
                                   nm, dn, fm)
@@ -105,7 +105,7 @@ def _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs,
 
 
 @njit(cache=True)
-def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
+def dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq, cq,
                     pmptr, pms, pmm, want_c, want_dm, fflat, kmat, its, stat, mout, cout, dout):
     """Solve every element and build its consistent mass (and damping) matrix (§6-7), and
     with ``want_dm`` the analytic ∂M_e/∂c_k (n, 3, 6, 6) (zero for slack elements).
@@ -113,15 +113,15 @@ def _dynamics_batch(chord, l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, 
     M_e = Σ_g m L0 w_g N(s_g)ᵀ N(s_g) + Σ_p m_p N(s_p)ᵀ N(s_p); C_e the same with c for m
     (point masses carry no material damping). Point masses inside elements: CSR ``pmptr``.
     """
-    x, g6, fg, dkk, gm, bm, fm, nm, dn = _dynamics_work()
+    x, g6, fg, dkk, gm, bm, fm, nm, dn = dynamics_work()
     for e in range(chord.shape[0]):
-        _dynamics_one(e, chord[e], l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq,
+        dynamics_one(e, chord[e], l0, ea, w, ptr, ls, lf, h, use_h, tol, max_iter, gs, gw, mq,
                       cq, pmptr, pms, pmm, True, want_c, want_dm, fflat, kmat, its, stat, mout,
                       cout, dout, x, g6, fg, dkk, gm, bm, fm, nm, dn)
 
 
 @njit(cache=True)
-def _mass_batch(h, kmat, stat, l0, ea, w, ptr, ls, lf, gs, gw, mq, pmptr, pms, pmm, out):
+def mass_batch(h, kmat, stat, l0, ea, w, ptr, ls, lf, gs, gw, mq, pmptr, pms, pmm, out):
     """Consistent element matrices (n, 6, 6) about solved tensions h (§7); see _mass_one."""
     x = np.empty(3)
     g6 = np.empty(6)
@@ -132,7 +132,7 @@ def _mass_batch(h, kmat, stat, l0, ea, w, ptr, ls, lf, gs, gw, mq, pmptr, pms, p
 
 
 @njit(cache=True)
-def _mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmptr, pms, pmm,
+def mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmptr, pms, pmm,
                          dout):
     """∂M_e/∂c_k (n, 3, 6, 6) by complex steps along the chord c = x_j - x_i.
 
@@ -155,7 +155,7 @@ def _mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmpt
         if stat[e] != CONVERGED:
             continue
         he = h[e]
-        fade = _gradient_fade(he, w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])  # near zero tension
+        fade = gradient_fade(he, w[e], l0[e], ls, lf, ptr[e], ptr[e + 1])  # near zero tension
         if fade == 0.0:
             continue
         t_max = np.sqrt(he[0] * he[0] + he[1] * he[1] + he[2] * he[2]) + abs(w[e] * l0[e])
@@ -166,9 +166,9 @@ def _mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmpt
             delta = 1e-30 * t_max / kc  # any small step: the derivative is in Im
             for m in range(3):
                 ht[m] = he[m] + 1j * delta * kmat[e, m, k]
-            ok = _partial(ht[0], ht[1], ht[2], w[e], ea[e], l0[e], ls, lf, ptr[e], ptr[e + 1],
-                          d, f6, True)
-            if not ok or not _inv_sym3(f6, kk):
+            ok = partial_solution(ht[0], ht[1], ht[2], w[e], ea[e], l0[e], ls, lf, ptr[e],
+                                  ptr[e + 1], d, f6, True)
+            if not ok or not inv_sym3(f6, kk):
                 continue
             _mass_one(ht, kk, False, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], gs[e],
                       gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm, True, mt, x, g6)
@@ -178,7 +178,7 @@ def _mass_gradient_batch(l0, ea, w, ptr, ls, lf, h, kmat, stat, gs, gw, mq, pmpt
 
 
 @njit(cache=True)
-def _dynamic_forces(edofs, h, load_total, wl0, me, use_m, ce, use_c, kmat, dm, use_dm, alpha,
+def dynamic_forces(edofs, h, load_total, wl0, me, use_m, ce, use_c, kmat, dm, use_dm, alpha,
                     beta, vel, acc, out):
     """out (n_dof,) = Σ_e [r_e + M_e a_e + C_e v_e + g_e] with Rayleigh and Lagrangian terms.
 

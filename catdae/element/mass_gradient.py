@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import _asinhc
+from catdae.element.catenary import asinhc
 
 
 @njit(cache=True, inline="always")
@@ -43,7 +43,7 @@ def _segment_grad(hx, hy, v, w, ea, a, b, f, fg):
     r = (ta + tb) / s_
     le = ell / ea
     z = w * ell * r
-    p = ell * r * _asinhc(z)
+    p = ell * r * asinhc(z)
     q = ell * r / (ta * tb)
     pp = (ta + tb) * ta * tb
     zz = ell * (ua + ub) / pp
@@ -127,7 +127,7 @@ def _sym3(f, out):
 
 
 @njit(cache=True)
-def _gradient_fade(he, w, l0, ls, lf, k0, k1):
+def gradient_fade(he, w, l0, ls, lf, k0, k1):
     """Weight (0..1) of ∂M/∂c for an element of end tension ``he``: the least tension along
     the element relative to the largest, t_min/t_max; ∂M/∂c grows like 1/t_min near a free
     end and is undefined at zero tension, so it is faded out smoothly (C1) between t_min/t_max
@@ -207,7 +207,7 @@ def _add_ntn_grad(g6, gg, kk, dkk, scale, out, dout, gm, bm, nm, dn):
 
 
 @njit(cache=True)
-def _mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm1, pms,
+def mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm1, pms,
                    pmm, fade, out, dout, f6, fg, dkk, gm, bm, nm, dn, fm):
     """Consistent element mass (as ``_mass_one``) and fade * ∂M_e/∂c_k (3, 6, 6), analytic.
 

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import NOT_CONVERGED
-from catdae.element.mass import _dynamic_forces, _dynamics_one, _dynamics_work
+from catdae.element.mass import dynamic_forces, dynamics_one, dynamics_work
 
 
 @njit(cache=True)
@@ -46,7 +46,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         X[d] = xp[k]
         V[d] = vp[k]
         A[d] = ap[k]
-    xw, g6, fg, dkk, gm, bm, fm, nm, dn = _dynamics_work()
+    xw, g6, fg, dkk, gm, bm, fm, nm, dn = dynamics_work()
     chord = np.empty(3)
     ne = conn.shape[0]
     for e in range(ne):
@@ -55,7 +55,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         for a in range(3):
             chord[a] = X[j + a] - X[i + a]
             hw[e, a] = h[e, a]
-        _dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, hw, use_h, tol, max_iter, gs, gw, mq,
+        dynamics_one(e, chord, l0, ea, w, ptr, ls, lf, hw, use_h, tol, max_iter, gs, gw, mq,
                       cq, pmptr, pms, pmm, want_m, want_c, want_dm, fflat, kmat, its, stat, me,
                       ce, dm, xw, g6, fg, dkk, gm, bm, fm, nm, dn)
         if stat[e] == NOT_CONVERGED:
@@ -77,7 +77,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                     for r in range(6):
                         for c in range(6):
                             dm[e, kk, r, c] *= scale
-    _dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm, want_dm, alpha,
+    dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm, want_dm, alpha,
                     beta, V, A, force)
     for k in range(n):
         d = fidx[k]

@@ -30,6 +30,7 @@ from catdae.element.fluid_kinematics import (
     PROFILE,
     UNIFORM,
     point_kinematics,
+    surface_elevation,
 )
 
 _EMPTY = np.zeros(0)
@@ -127,6 +128,26 @@ def wave_components(waves: Waves, g: float, depth: float) -> tuple[np.ndarray, .
     return amp, om, k, np.full(n, math.cos(b)), np.full(n, math.sin(b)), ph
 
 
+def _wave_ramp(waves: Waves) -> Ramp | None:
+    """The waves rise over ``ramp`` s as the quintic smoothstep (C2: no restart needed)."""
+    return Ramp(waves.ramp, smooth=True) if waves.ramp > 0 else None
+
+
+def elevation(waves: Waves, g: float, depth: float, xy, times) -> np.ndarray:
+    """The wave elevation above the still-water level (m), (n_times, n_points), at the points
+    ``xy`` (n_points, 2) of the gravity frame's horizontal plane, as the Morison pass sees it
+    (ramp included): for the water surface in the ParaView export."""
+    comps = wave_components(waves, g, depth)
+    ramp = _wave_ramp(waves)
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    out = np.zeros((len(times), xy.shape[0]))
+    for k, t in enumerate(times):
+        r = 1.0 if ramp is None else float(ramp.evaluate(float(t))[0])
+        for p in range(xy.shape[0]):
+            out[k, p] = surface_elevation(xy[p, 0], xy[p, 1], float(t), *comps, r)[0]
+    return out
+
+
 class Fluid:
     """The fluids of one step and the per-element line properties the Morison pass reads."""
 
@@ -178,9 +199,7 @@ class Fluid:
         self.waves = waves
         self.wave = (wave_components(waves, self.g, self.depth) if waves is not None
                      else (_EMPTY,) * 6)
-        # the waves rise over ``ramp`` s as the quintic smoothstep (C2: no restart needed)
-        self._ramp = (Ramp(waves.ramp, smooth=True) if waves is not None and waves.ramp > 0
-                      else None)
+        self._ramp = _wave_ramp(waves) if waves is not None else None
         self.rho_a = air.density if air is not None else 0.0
         wind = air.wind if air is not None else None
         self.a_time = wind.time if wind is not None else None
@@ -262,15 +281,17 @@ class Fluid:
         z = np.zeros(np.size(X))
         return self.evaluate(t, X, z, z, waves=False)[1]
 
-    def kinematics(self, points: np.ndarray, t: float):
+    def kinematics(self, points: np.ndarray, t: float, waves: bool = True):
         """Surface elevation above the still level at the points' (x, y), (n,) m, and the fluid
-        velocity at the points (water below the surface, air above), (n, 3) m/s."""
-        cf, af, r, dr = self._factors(t, True)
+        velocity at the points (water below the surface, air above), (n, 3) m/s; without
+        ``waves`` in still water (as static and modal steps see it)."""
+        cf, af, r, dr = self._factors(t, waves)
         pts = np.ascontiguousarray(points, float).reshape(-1, 3)
         eta = np.zeros(pts.shape[0])
         vel = np.zeros((pts.shape[0], 3))
         point_kinematics(pts, float(t), self.rho_w, self.surface, self.depth, self.c_kind,
-                         self.c_vec, self.c_z, self.c_v, cf, *self.wave, r, dr, self.rho_a,
+                         self.c_vec, self.c_z, self.c_v, cf,
+                         *(self.wave if waves else (_EMPTY,) * 6), r, dr, self.rho_a,
                          self.a_kind, self.a_vec, self.a_speed, self.a_dir, self.a_expo,
                          self.a_zref, self.a_ground, af, eta, vel)
         return eta, vel

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
-from catdae.output.results import _label, _var
+from catdae.output.results import label, var
 
 
 def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
@@ -26,11 +26,11 @@ def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
                   for k in range(flat_x.shape[0])]).reshape(*lead, connectors.n)
     dims = ("time", "connector") if lead else ("connector",)
     return ds.assign(
-        connector_force=_var(dims, N, "N", "axial force of the connector (tension positive): "
+        connector_force=var(dims, N, "N", "axial force of the connector (tension positive): "
                              "k (d - L) + c dd/dt"),
     ).assign_coords(
-        connector=_label("connector", connectors.names, "connector name"),
-        connector_kind=_label("connector", connectors.kinds, "spring, damper or bar"),
+        connector=label("connector", connectors.names, "connector name"),
+        connector_kind=label("connector", connectors.kinds, "spring, damper or bar"),
     )
 
 
@@ -53,16 +53,16 @@ def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
     return ds.assign(
         undamped_frequency=ds["frequency"].assign_attrs(
             long_name="natural frequency of the undamped system"),
-        frequency=_var("mode", pad(modes.frequency), "Hz",
+        frequency=var("mode", pad(modes.frequency), "Hz",
                        "damped natural frequency Im(s)/2π"),
-        damping_ratio=_var("mode", pad(modes.damping_ratio), "1",
+        damping_ratio=var("mode", pad(modes.damping_ratio), "1",
                            "modal damping ratio -Re(s)/|s|"),
-        eigenvalue_real=_var("mode", pad(modes.s.real), "1/s", "Re(s) of the damped mode"),
-        eigenvalue_imag=_var("mode", pad(modes.s.imag), "rad/s", "Im(s) of the damped mode"),
-        complex_shape=_var(("mode", "part", "node", "axis"), shape, "1",
+        eigenvalue_real=var("mode", pad(modes.s.real), "1/s", "Re(s) of the damped mode"),
+        eigenvalue_imag=var("mode", pad(modes.s.imag), "rad/s", "Im(s) of the damped mode"),
+        complex_shape=var(("mode", "part", "node", "axis"), shape, "1",
                            "complex shape of the damped mode (largest component = 1)"),
-        damped_plane=_label("mode", list(plane[:k]) + labels[k:],
+        damped_plane=label("mode", list(plane[:k]) + labels[k:],
                             "plane of the damped mode (from the real part of its shape)"),
-        damped_symmetry=_label("mode", list(symmetry[:k]) + labels[k:],
+        damped_symmetry=label("mode", list(symmetry[:k]) + labels[k:],
                                "symmetry of the damped mode (from the real part of its shape)"),
-    ).assign_coords(part=_label("part", ["real", "imag"], "part of the complex shape"))
+    ).assign_coords(part=label("part", ["real", "imag"], "part of the complex shape"))

@@ -10,6 +10,20 @@ Point data: ``displacement`` (and ``velocity``, ``acceleration`` in transients) 
 m/s²; cell data: ``tension_i``, ``tension_j`` (N, at the element's two ends) and
 ``tension`` (their mean). Node and element order are those of the results (``node``,
 ``element``), so point k is ``node[k]`` and cell e is ``element[e]``.
+
+In water or on a seabed (the group's ``water_surface`` and ``seabed_z``,
+catdae.output.environment) the collection has two more parts, planes normal to ``up`` over
+the cables' horizontal extent (widened by 10 %, at least 1 m, on each side):
+
+    <folder>/<step>/<step>_seabed.vtu         part 1: the seabed, one quad, at every time
+    <folder>/<step>/<step>_water.vtu          part 2: the still-water level (no waves)
+    <folder>/<step>/<step>_water_00000.vtu    part 2 with waves: a grid (about 10 points per
+                                              shortest wave length, at most 101 a side) at the
+                                              surface of each output time, point data
+                                              ``elevation`` (m above the still level)
+
+The waves come from the case in the results (the root's ``case_toml``); when it cannot be read
+back (a table file no longer where it was), the still-water plane stands in for them.
 """
 
 from __future__ import annotations
@@ -24,6 +38,7 @@ import numpy as np
 from catdae._xr import xr
 from catdae.errors import CatdaeError
 from catdae.interrupts import deferred
+from catdae.output import environment as env
 
 
 class ExportError(CatdaeError):
@@ -36,9 +51,64 @@ def _cells(ds: xr.Dataset) -> np.ndarray:
     return np.vectorize(index.__getitem__, otypes=[np.int64])(ds.element_node.values.astype(str))
 
 
-def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str) -> Path:
+def _write(f: Path, points, cells, **data) -> None:
+    with deferred():  # a signal waits until the file is complete
+        meshio.write(f, meshio.Mesh(points, cells, **data), file_format="vtu")
+
+
+def _environment(ds: xr.Dataset, sub: Path, name: str, times, case) -> list[list[Path]]:
+    """The seabed's and the water surface's files: per part, one file per time (or one for
+    all)."""
+    if "seabed_z" not in ds.attrs and "water_surface" not in ds.attrs:
+        return []
+    R = env.frame_of(ds)
+    lo, hi = env.horizontal_extent(ds, R)
+    parts = []
+    if "seabed_z" in ds.attrs:
+        xy, quads = env.grid(lo, hi, (2, 2))
+        f = sub / f"{name}_seabed.vtu"
+        _write(f, env.to_global(R, xy, float(ds.attrs["seabed_z"])), [("quad", quads)])
+        parts.append([f])
+    if "water_surface" in ds.attrs:
+        h = float(ds.attrs["water_surface"])
+        water = getattr(case, "water", None)
+        if water is None or water.waves is None or "surface_elevation" not in ds:
+            xy, quads = env.grid(lo, hi, (2, 2))
+            f = sub / f"{name}_water.vtu"
+            _write(f, env.to_global(R, xy, h), [("quad", quads)])
+            parts.append([f])
+        else:
+            from catdae.model.fluid import elevation
+
+            size = env.wave_grid_size(water.waves, case.gravity, water.depth, lo, hi)
+            xy, quads = env.grid(lo, hi, size)
+            eta = elevation(water.waves, case.gravity, water.depth, xy, times)
+            files = []
+            for k in range(len(times)):
+                f = sub / f"{name}_water_{k:05d}.vtu"
+                _write(f, env.to_global(R, xy, h + eta[k]), [("quad", quads)],
+                       point_data={"elevation": eta[k]})
+                files.append(f)
+            parts.append(files)
+    return parts
+
+
+def _case_of(tree: xr.DataTree):
+    """The case in the results' root (for its waves), or None when it cannot be read back."""
+    from catdae.case import load_case
+
+    text = tree.attrs.get("case_toml")
+    if not text:
+        return None
+    try:
+        return load_case(str(text), name=str(tree.attrs.get("case_name", "case")))
+    except (CatdaeError, OSError, ValueError):
+        return None
+
+
+def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str, case=None) -> Path:
     """One step's time series: the ``.vtu`` files and the ``.pvd`` collection; returns the
-    collection's path."""
+    collection's path. ``case`` (its waves) draws the water surface of each time."""
     from catdae.output.reading import step_problem
 
     if (why := step_problem(ds)) is not None:
@@ -52,8 +122,8 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str) -> Path:
     cells = [("line", _cells(ds))]
     times = ds.time.values if "time" in ds.dims else np.array([float(ds.attrs.get("t", 0.0))])
     point_vars = [v for v in ("displacement", "velocity", "acceleration") if v in ds]
-    entries = []
-    for k, t in enumerate(times):
+    files = []
+    for k in range(times.size):
         at = ds.isel(time=k) if "time" in ds.dims else ds
         tens = at.tension.values  # (n_elem, 2) N
         mesh = meshio.Mesh(
@@ -66,8 +136,12 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str) -> Path:
         f = sub / f"{name}_{k:05d}.vtu"
         with deferred():  # a signal waits until the file is complete
             meshio.write(f, mesh, file_format="vtu")
-        entries.append(f'    <DataSet timestep="{float(t)!r}" part="0" '
-                       f'file={quoteattr(f.relative_to(folder).as_posix())}/>')
+        files.append(f)
+    # part 0 the cables; parts 1, 2 the seabed and the water surface (one file, or one a time)
+    parts = [files, *_environment(ds, sub, name, times, case)]
+    entries = [f'    <DataSet timestep="{float(t)!r}" part="{p}" '
+               f'file={quoteattr(fs[min(k, len(fs) - 1)].relative_to(folder).as_posix())}/>'
+               for k, t in enumerate(times) for p, fs in enumerate(parts)]
     pvd = folder / f"{name}.pvd"
     with deferred():
         pvd.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
@@ -86,4 +160,6 @@ def write_vtk(tree: xr.DataTree, folder: str | os.PathLike, steps=None) -> list[
         raise ExportError(f"no step {unknown[0]!r} in the results (steps: "
                           f"{', '.join(tree.children)})")
     Path(folder).mkdir(parents=True, exist_ok=True)
-    return [write_step(tree[n].to_dataset(), folder, n) for n in names]
+    waves = any("surface_elevation" in tree[n].to_dataset() for n in names)
+    case = _case_of(tree) if waves else None
+    return [write_step(tree[n].to_dataset(), folder, n, case) for n in names]

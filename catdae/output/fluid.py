@@ -1,13 +1,14 @@
-"""Result variables of a transient step in water or air (docs/case-format.md, "Water and air"):
-the water surface above the nodes and the fluid velocity at them."""
+"""Result variables of a step in water or air (docs/case-format.md, "Water and air"): the
+water surface above the nodes and the fluid velocity at them."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from catdae._xr import xr
+from catdae.element.fluid_kinematics import NONE
 from catdae.model.fluid import Fluid
-from catdae.output.results import _var
+from catdae.output.results import var
 
 
 def with_fluid(ds: xr.Dataset, fluid: Fluid, times: np.ndarray, X: np.ndarray) -> xr.Dataset:
@@ -21,10 +22,23 @@ def with_fluid(ds: xr.Dataset, fluid: Fluid, times: np.ndarray, X: np.ndarray) -
     out = ds.copy()
     if fluid.water is not None:
         out.attrs["water_surface"] = float(fluid.surface)  # m, z of the still-water level
-    out["fluid_velocity"] = _var(("time", "node", "axis"), vel, "m/s",
+    out["fluid_velocity"] = var(("time", "node", "axis"), vel, "m/s",
                                  "velocity of the water (below the surface) or the air at the node")
     if fluid.waves is not None:
-        out["surface_elevation"] = _var(("time", "node"), eta, "m",
+        out["surface_elevation"] = var(("time", "node"), eta, "m",
                                          "elevation of the water surface above the still-water "
                                          "level at the node's (x, y)")
+    return out
+
+
+def with_static_fluid(ds: xr.Dataset, fluid: Fluid | None, X: np.ndarray, t: float) -> xr.Dataset:
+    """A static group with ``fluid_velocity``(node, axis) of the still water (the current) or
+    the air (the wind) at the nodes, as the step saw it (no waves), when there is a current or
+    a wind; ``X`` (n_nodes, 3) in the group's node order."""
+    if fluid is None or (fluid.c_kind == NONE and fluid.a_kind == NONE):
+        return ds
+    vel = fluid.kinematics(np.asarray(X, float).reshape(-1, 3), float(t), waves=False)[1]
+    out = ds.copy()
+    out["fluid_velocity"] = var(("node", "axis"), vel, "m/s", "velocity of the still water "
+                                 "(below the surface) or the air at the node")
     return out

@@ -28,6 +28,7 @@ from matplotlib.figure import Figure
 from catdae._xr import xr
 from catdae.errors import CatdaeError
 from catdae.interrupts import deferred
+from catdae.output.environment import still_levels
 from catdae.output.plot_envelopes import mark_peaks, reactions
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
@@ -135,6 +136,8 @@ def profile(data, times=None, what: str = "position") -> Figure:
                 eta = ds.surface_elevation.sel(time=t, node=nodes)
                 ax_e.plot(pts.sel(axis="x"), ds.attrs.get("water_surface", 0.0) + eta,
                           ls="--", lw=0.8, color=line.get_color(), gid=f"surface|{cab}|{t}")
+    if what == "position":
+        still_levels(ax_e, ds)
     name = var.attrs.get("long_name", what)
     ax_e.set_ylabel(label(var, f"{name}, z"))
     ax_p.set_ylabel(label(var, f"{name}, y"))

@@ -18,6 +18,7 @@ import numpy as np
 from catdae._version import __version__
 from catdae._xr import xr
 from catdae.model.mesh import AXES, Mesh
+from catdae.output.environment import environment_attrs
 from catdae.output.files import INCOMPLETE_SUFFIX, clean_stale, incomplete_name  # noqa: F401
 
 CONVENTIONS = "CF-1.10"
@@ -35,11 +36,11 @@ TIME_ATTRS = {"units": TIME_UNITS, "calendar": "proleptic_gregorian", "standard_
               "axis": "T"}
 
 
-def _var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
+def var(dims, data, units: str, long_name: str, **attrs) -> xr.Variable:
     return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name, **attrs})
 
 
-def _label(dims, values, long_name: str) -> xr.Variable:
+def label(dims, values, long_name: str) -> xr.Variable:
     """A string coordinate: labels carry no units."""
     return xr.Variable(dims, np.array(values, dtype=object), {"long_name": long_name})
 
@@ -51,22 +52,22 @@ def _coords(mesh: Mesh, with_elements: bool = True) -> dict:
     names = np.array((*mesh.cable_names, ""), dtype=object)  # "": no cable at all
     node_cable = np.where(on_cable, names[np.maximum(mesh.cable_of_node, 0)], "")
     coords = {
-        "node": _label("node", mesh.node_names, "node name"),
-        "axis": _label("axis", AXES, "global axis (z up)"),
-        "node_cable": _label("node", node_cable,
+        "node": label("node", mesh.node_names, "node name"),
+        "axis": label("axis", AXES, "global axis (z up)"),
+        "node_cable": label("node", node_cable,
                              "cable of the node (the first one through it; empty: none)"),
-        "s": _var("node", mesh.s_node, "m", "unstrained arc length along node_cable"),
+        "s": var("node", mesh.s_node, "m", "unstrained arc length along node_cable"),
     }
     if with_elements:
         names = np.array(mesh.node_names, dtype=object)
         s_ends = np.stack([mesh.s_start, mesh.s_start + mesh.L0], axis=1)  # (n_elem, 2) m
-        coords["element"] = _label("element", mesh.element_names, "element name")
-        coords["end"] = _label("end", ["i", "j"], "element end")
-        coords["element_cable"] = _label("element", np.array(mesh.cable_names, dtype=object)[
+        coords["element"] = label("element", mesh.element_names, "element name")
+        coords["end"] = label("end", ["i", "j"], "element end")
+        coords["element_cable"] = label("element", np.array(mesh.cable_names, dtype=object)[
             mesh.cable_of_element], "cable of the element")
-        coords["element_node"] = _label(("element", "end"), names[mesh.conn],
+        coords["element_node"] = label(("element", "end"), names[mesh.conn],
                                         "node at the element end")
-        coords["element_s"] = _var(("element", "end"), s_ends, "m",
+        coords["element_s"] = var(("element", "end"), s_ends, "m",
                                    "unstrained arc length of the element end along its cable")
     return coords
 
@@ -94,26 +95,26 @@ def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.
     d = ("node", "axis")
     ds = xr.Dataset(
         {
-            "position": _var(d, X, "m", "node position"),
-            "displacement": _var(d, X - mesh.X0, "m", "displacement from reference_position"),
-            "reference_position": _var(d, mesh.X0, "m",
+            "position": var(d, X, "m", "node position"),
+            "displacement": var(d, X - mesh.X0, "m", "displacement from reference_position"),
+            "reference_position": var(d, mesh.X0, "m",
                                        "meshed catenary under self-weight (reference)"),
-            "tension": _var(("element", "end"), tension, "N", "cable tension at element end"),
-            "reaction": _var(d, reaction, "N",
+            "tension": var(("element", "end"), tension, "N", "cable tension at element end"),
+            "reaction": var(d, reaction, "N",
                              "force the support exerts on the cable (NaN where free)"),
         },
         coords=_coords(mesh),
         attrs=clean_attrs({"kind": "static", **attrs}),
     )
     if cables is not None:
-        ds = ds.assign_coords(cable=_label("cable", mesh.cable_names, "cable name"))
-        ds["cable_end_tension"] = _var(("cable", "end"), cables["end_tension"], "N",
+        ds = ds.assign_coords(cable=label("cable", mesh.cable_names, "cable name"))
+        ds["cable_end_tension"] = var(("cable", "end"), cables["end_tension"], "N",
                                        "tension at the cable's first (i) and last (j) end")
-        ds["horizontal_tension"] = _var("cable", cables["horizontal_tension"], "N",
+        ds["horizontal_tension"] = var("cable", cables["horizontal_tension"], "N",
                                         "horizontal tension at the cable's first end")
-        ds["sag"] = _var("cable", cables["sag"], "m",
+        ds["sag"] = var("cable", cables["sag"], "m",
                          "largest vertical distance from chord to cable")
-        ds["unstrained_length"] = _var("cable", cables["unstrained_length"], "m",
+        ds["unstrained_length"] = var("cable", cables["unstrained_length"], "m",
                                        "unstrained length L0 at the reference temperature")
     return ds
 
@@ -127,12 +128,12 @@ def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, s
                                  {"long_name": "mode number"})
     ds = xr.Dataset(
         {
-            "frequency": _var("mode", frequency, "Hz", "natural frequency"),
-            "shape": _var(("mode", "node", "axis"), shape, "1",
+            "frequency": var("mode", frequency, "Hz", "natural frequency"),
+            "shape": var(("mode", "node", "axis"), shape, "1",
                           "mode shape (largest nodal displacement component = 1)"),
-            "plane": _label("mode", plane,
+            "plane": label("mode", plane,
                             "in-plane or out-of-plane (single-span cables; else unclassified)"),
-            "symmetry": _label("mode", symmetry,
+            "symmetry": label("mode", symmetry,
                                "symmetric or antisymmetric about midspan (single-span cables)"),
         },
         coords=coords,
@@ -150,19 +151,19 @@ def transient_dataset(mesh: Mesh, time: np.ndarray, X, V, A, tension, reaction, 
                                  encoding={"_FillValue": None})  # CF: none on coordinates
     X = np.asarray(X).reshape(len(time), mesh.X0.shape[0], 3)  # 0 outputs too: an early stop
     data = {
-        "position": _var(d, X, "m", "node position"),
-        "displacement": _var(d, X - mesh.X0[None], "m", "displacement from reference_position"),
-        "velocity": _var(d, np.asarray(V).reshape(X.shape), "m/s", "node velocity"),
-        "acceleration": _var(d, np.asarray(A).reshape(X.shape), "m/s2", "node acceleration"),
-        "reference_position": _var(("node", "axis"), mesh.X0, "m",
+        "position": var(d, X, "m", "node position"),
+        "displacement": var(d, X - mesh.X0[None], "m", "displacement from reference_position"),
+        "velocity": var(d, np.asarray(V).reshape(X.shape), "m/s", "node velocity"),
+        "acceleration": var(d, np.asarray(A).reshape(X.shape), "m/s2", "node acceleration"),
+        "reference_position": var(("node", "axis"), mesh.X0, "m",
                                    "meshed catenary under self-weight (reference)"),
-        "tension": _var(("time", "element", "end"), tension, "N",
+        "tension": var(("time", "element", "end"), tension, "N",
                         "cable tension at element end"),
-        "reaction": _var(d, reaction, "N",
+        "reaction": var(d, reaction, "N",
                          "force the support exerts on the cable (NaN where free)"),
     }
     for key, (values, long_name) in energy.items():
-        data[key] = _var("time", values, "J", long_name)
+        data[key] = var("time", values, "J", long_name)
     return xr.Dataset(data, coords=coords, attrs=clean_attrs({"kind": "transient", **attrs}))
 
 
@@ -170,7 +171,9 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     """Root with provenance and one group per step, in step order.
 
     Every group also has ``Conventions``, ``history`` and a ``title``, so that a group written
-    as a file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them.
+    as a file of its own (``tree[name].to_dataset().to_netcdf(...)``) still declares them, and
+    in water or on a seabed ``up``, ``water_surface``, ``water_depth``, ``seabed_z``
+    (catdae.output.environment).
     """
     created = datetime.now(UTC).isoformat(timespec="seconds")
     history = f"{created} catdae {__version__}: run of case {case.name!r} ({status})"
@@ -185,8 +188,9 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
         "Conventions": CONVENTIONS,
         "history": history,
     }))
+    env = environment_attrs(case)  # the water surface and seabed (figures, the VTK export)
     groups = {k: v.assign_attrs(Conventions=CONVENTIONS, history=history,
-                                title=f"{case.title or case.name}: step {k}")
+                                title=f"{case.title or case.name}: step {k}", **env)
               for k, v in groups.items()}
     return xr.DataTree.from_dict({"/": root, **{f"/{k}": v for k, v in groups.items()}})
 

@@ -6,16 +6,16 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
-from catdae.output.results import _label, _var
+from catdae.output.results import label, var
 
 
 def add_seabed(ds: xr.Dataset, mesh, summary: dict) -> xr.Dataset:
     """``ds`` with ``seabed_length``(cable) and ``touchdown``(cable, axis)."""
     if "cable" not in ds.coords:
-        ds = ds.assign_coords(cable=_label("cable", mesh.cable_names, "cable name"))
-    ds["seabed_length"] = _var("cable", summary["seabed_length"], "m",
+        ds = ds.assign_coords(cable=label("cable", mesh.cable_names, "cable name"))
+    ds["seabed_length"] = var("cable", summary["seabed_length"], "m",
                                "unstrained length of cable resting on the seabed")
-    ds["touchdown"] = _var(("cable", "axis"), summary["touchdown"], "m",
+    ds["touchdown"] = var(("cable", "axis"), summary["touchdown"], "m",
                            "touchdown point: where the cable leaves the seabed (NaN: none)")
     return ds
 
@@ -48,18 +48,18 @@ def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Data
                 e = leave[0]
                 td[k, c] = pos[k, a[e]] if on[k, a[e]] else pos[k, b[e]]
     if "cable" not in ds.coords:
-        ds = ds.assign_coords(cable=_label("cable", mesh.cable_names, "cable name"))
-    ds["seabed_length"] = _var(("time", "cable"), length, "m",
+        ds = ds.assign_coords(cable=label("cable", mesh.cable_names, "cable name"))
+    ds["seabed_length"] = var(("time", "cable"), length, "m",
                                "unstrained length of cable resting on the seabed")
-    ds["touchdown"] = _var(("time", "cable", "axis"), td, "m",
+    ds["touchdown"] = var(("time", "cable", "axis"), td, "m",
                            "touchdown point: where the cable leaves the seabed (NaN: none)")
     if contact is not None:  # the power the seabed's damping and friction take out, and its work
         vel = ds.velocity.transpose("time", "node", "axis").values[:, order]
         power = np.array([contact.dissipation(pos[k], vel[k]) for k in range(z.shape[0])])
         t = ds.time.values
         work = np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * np.diff(t))])
-        ds["seabed_dissipation"] = _var("time", power, "W",
+        ds["seabed_dissipation"] = var("time", power, "W",
                                         "power taken out by the seabed's damping and friction")
-        ds["seabed_work"] = _var("time", work, "J", "energy taken out by the seabed's damping "
+        ds["seabed_work"] = var("time", work, "J", "energy taken out by the seabed's damping "
                                  "and friction since the step's start (trapezoidal rule)")
     return ds

@@ -37,13 +37,13 @@ def envelope_variables(env) -> dict:
     d = ("element", "end")
     how = "over every accepted integrator step and output"
     return {
-        "tension_max": results._var(d, env.t_max.copy(), "N",
+        "tension_max": results.var(d, env.t_max.copy(), "N",
                                     f"largest cable tension at element end, {how}"),
-        "tension_min": results._var(d, env.t_min.copy(), "N",
+        "tension_min": results.var(d, env.t_min.copy(), "N",
                                     f"smallest cable tension at element end, {how}"),
-        "time_tension_max": results._var(d, env.time_max.copy(), "s",
+        "time_tension_max": results.var(d, env.time_max.copy(), "s",
                                          "time of tension_max on the case's clock"),
-        "time_tension_min": results._var(d, env.time_min.copy(), "s",
+        "time_tension_min": results.var(d, env.time_min.copy(), "s",
                                          "time of tension_min on the case's clock"),
     }
 

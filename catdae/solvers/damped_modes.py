@@ -25,6 +25,7 @@ from catdae.element.elements import ElementState
 from catdae.errors import ConvergenceError
 from catdae.model.assembly import Model
 from catdae.model.connectors import extend
+from catdae.model.settings import DampingModel
 
 DENSE_LIMIT = 200  # size 2 n_free of the pencil up to which the dense solver is used
 DENSE_FALLBACK = 4000  # up to which size the dense solver takes over when ARPACK fails
@@ -104,11 +105,12 @@ def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
     if has_dampers:
         data += model.pattern.assemble(
             extend(None, cn.damping_blocks(X), model.mesh.n_elements))
-    if damping is not None and damping.kind == "rayleigh":
-        alpha, beta = damping.coefficients()
+    dm = DampingModel.of_step(damping)
+    if dm.damped and not dm.material:  # Rayleigh
+        alpha, beta = dm.alpha, dm.beta
         # β K on the elements' stiffness alone, as in the transient residual (docs/theory.md §15)
         data += alpha * model.mass_data(state) + beta * model.stiffness_data(state)
-    elif damping is not None:  # material
+    elif dm.material:
         ce = None
         if model.mass_model.linear:
             ce = model.linear_element_mass(damping=True)

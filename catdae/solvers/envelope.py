@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from catdae.element.catenary import NOT_CONVERGED, _solve_one
-from catdae.element.catenary_batch import _solve_batch
+from catdae.element.catenary import NOT_CONVERGED, solve_one
+from catdae.element.catenary_batch import solve_batch
 from catdae.solvers.axial_damping import element_g
 
 CARRY = 1e-4  # largest relative change of an end force carried to first order
@@ -68,7 +68,7 @@ def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, l
         if change > CARRY * CARRY * (hb[e, 0] ** 2 + hb[e, 1] ** 2 + hb[e, 2] ** 2):
             for a in range(3):
                 h[a] = hb[e, a]
-            _its, status = _solve_one(c, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h,
+            _its, status = solve_one(c, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h,
                                       True, 1e-12, 100, f6, k33)
             if status == NOT_CONVERGED:
                 return -1
@@ -145,7 +145,7 @@ class TensionEnvelope:
         el = m.elements
         use_h = self._h is not None
         h = self._h if use_h else np.zeros_like(self._chord)
-        _solve_batch(self._chord, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf, h, use_h,
+        solve_batch(self._chord, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf, h, use_h,
                      1e-12, 100, self._f, self._k, self._its, self._stat)
         if (self._stat == NOT_CONVERGED).any() or not np.all(np.isfinite(h)):
             self._h = None

@@ -199,12 +199,12 @@ def _extreme_frequency(prob: TransientProblem, t0: float, y0: np.ndarray,
     return None
 
 
-def _highest_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float | None:
+def highest_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float | None:
     """ω_max about the start (rad/s), or None: the stability scale of OrderChoice."""
     return _extreme_frequency(prob, t0, y0, highest=True)
 
 
-def _reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:
+def reference_frequency(prob: TransientProblem, t0: float, y0: np.ndarray) -> float:
     """ω of the lowest mode about the start (rad/s): scales the velocity tolerance (2π if it
     cannot be had)."""
     omega = _extreme_frequency(prob, t0, y0, highest=False)

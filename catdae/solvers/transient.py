@@ -26,8 +26,8 @@ from catdae.model.assembly import Model
 from catdae.progress import reporter
 from catdae.solvers.order import (
     OrderChoice,
-    _highest_frequency,
-    _reference_frequency,
+    highest_frequency,
+    reference_frequency,
 )
 from catdae.solvers.record import OutputRecord, note
 from catdae.solvers.residual import TransientProblem
@@ -109,12 +109,12 @@ class _Run:
         order cap (fixed, or raced by OrderChoice)."""
         step, prob, t0, y0 = self.step, self.prob, self.t0, self.y0
         self.linsolver = choose_solver(prob, step.linear_solver)
-        self.omega = _reference_frequency(prob, t0, y0)
+        self.omega = reference_frequency(prob, t0, y0)
         atol = np.empty(2 * prob.n)
         atol[0::2] = step.atol
         atol[1::2] = step.atol * self.omega
         self.auto = step.max_order == "auto"
-        self.order_choice = (OrderChoice(_highest_frequency(prob, t0, y0), self.omega,
+        self.order_choice = (OrderChoice(highest_frequency(prob, t0, y0), self.omega,
                                          self.t_end) if self.auto else None)
         options = dict(rtol=step.rtol, atol=atol,
                        max_order=self.order_choice.order if self.auto else int(step.max_order),
@@ -244,19 +244,9 @@ class _Run:
                 work.advance(t_int, y_last, yp_last)
             if at_stop:
                 t_int = t_stop
-                y_last, yp_last = prob.restart(t_stop, y_last, befores[i_stop])
-                if work is not None:
-                    work.advance(t_int, y_last, yp_last)
-                self.n_restarts += 1
                 i_stop += 1
-                if i_stop < len(stops):
-                    solver.init_step(t_stop, y_last, yp_last)
-                    if self.order_choice is not None:
-                        self.order_choice.restart()
-                while (self.k_done < times.size
-                       and abs(times[self.k_done] - t_int) <= 1e-13 * max(abs(t_int), 1.0)):
-                    record(self.k_done, times[self.k_done], y_last, yp_last)
-                    self.k_done += 1
+                self._restart(solver, t_stop, y_last, befores[i_stop - 1],
+                              more=i_stop < len(stops))
             elif self.order_choice is not None and self.order_choice.measuring:
                 new_order = self.order_choice.observe(t_int)
                 if new_order is not None:
@@ -266,6 +256,25 @@ class _Run:
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(self.step.name, self.snapshot(self.k_done))
                 last_write = _time.perf_counter()
+
+    def _restart(self, solver, t_stop: float, y_last, before, more: bool) -> None:
+        """A stop (support velocity jump, or the end of a record): a consistent restart
+        (docs/theory.md §8), the outputs at the stop from the restarted state, and IDA
+        re-initialised there if more of the step follows."""
+        y_last, yp_last = self.prob.restart(t_stop, y_last, before)
+        work = self.outputs.work
+        if work is not None:
+            work.advance(t_stop, y_last, yp_last)
+        self.n_restarts += 1
+        if more:
+            solver.init_step(t_stop, y_last, yp_last)
+            if self.order_choice is not None:
+                self.order_choice.restart()
+        times = self.times
+        while (self.k_done < times.size
+               and abs(times[self.k_done] - t_stop) <= 1e-13 * max(abs(t_stop), 1.0)):
+            self.outputs.record(self.k_done, times[self.k_done], y_last, yp_last)
+            self.k_done += 1
 
     def _record_passed(self, solver, t_int, y_last, yp_last, at_stop) -> None:
         """Record the output times that the last step passed (interpolated by IDA; one that

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from catdae.errors import CaseError, OutputError
-from catdae.study.core import _CHOICES, StudyError
+from catdae.study.core import CHOICES, StudyError
 from catdae.study.report import summary, write_study
 from catdae.study.runner import run_study
 
@@ -26,8 +26,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--atol", type=float, nargs="+", help="m")
     p.add_argument("--elements", type=int, nargs="+", help="elements per cable")
     p.add_argument("--gauss-points", type=int, nargs="+")
-    p.add_argument("--mass-model", nargs="+", choices=_CHOICES["mass_model"])
-    p.add_argument("--linear-solver", nargs="+", choices=_CHOICES["linear_solver"])
+    p.add_argument("--mass-model", nargs="+", choices=CHOICES["mass_model"])
+    p.add_argument("--linear-solver", nargs="+", choices=CHOICES["linear_solver"])
     p.add_argument("--max-order", type=int, nargs="+")
     p.add_argument("--response", help="transient: a case node, <cable>@<p/q> or <cable>.<k> of "
                    "the case file's mesh (default: the common node moving most); modal: how "
@@ -77,7 +77,7 @@ def _reference_arg(items: list[str] | None):
         key = key.strip().replace("-", "_")
         if not eq:
             raise StudyError(f"reference: expected KEY=VALUE, found {item!r}")
-        if key in _CHOICES:
+        if key in CHOICES:
             out[key] = value
         else:
             try:

@@ -24,7 +24,7 @@ MODAL_SETTINGS = ("elements", "gauss_points", "mass_model")
 STATIC_SETTINGS = ("elements", "gauss_points")  # catdae.study.quantity
 STORE_FORMAT = 1  # bump when the stored runs change meaning
 
-_COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
+COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "rtol": ("1", "relative tolerance of IDA"),
     "atol": ("m", "absolute tolerance of IDA on displacements"),
     "elements": ("1", "elements per cable (0: as in the case file)"),
@@ -33,10 +33,10 @@ _COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "linear_solver": ("", "linear solver requested"),
     "max_order": ("1", "largest BDF order of IDA"),
 }
-_CHOICES = {"mass_model": MASS_MODEL_NAMES,
+CHOICES = {"mass_model": MASS_MODEL_NAMES,
             "linear_solver": ("auto", "band", "sparse", "dense")}
-_COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
-_MEMORY_NAMES = {
+COUNTS = ("n_steps", "n_residual_evaluations", "n_jacobian_evaluations")
+MEMORY_NAMES = {
     "peak_rss": "growth of the worker's resident set size during the run (VmHWM reset)",
     "maxrss": "growth of the worker's lifetime peak resident set size (ru_maxrss)",
     "tracemalloc": "peak of Python and numpy allocations (tracemalloc)",
@@ -106,8 +106,8 @@ def _check_value(name: str, v) -> str | None:
     if name in ("rtol", "atol"):
         ok = isinstance(v, int | float) and not isinstance(v, bool) and 0 < v < math.inf
         return None if ok else f"expected a finite number > 0, found {v!r}"
-    if name in _CHOICES:
-        return None if v in _CHOICES[name] else f"expected one of {_CHOICES[name]}, found {v!r}"
+    if name in CHOICES:
+        return None if v in CHOICES[name] else f"expected one of {CHOICES[name]}, found {v!r}"
     if name == "max_order" and v == "auto":
         return None
     lo, hi = {"elements": (1, 10**6), "gauss_points": (1, 10), "max_order": (1, 5)}[name]
@@ -203,7 +203,7 @@ def _mesh_points(case_run: Case) -> set[str]:
     return {lab for lab in point_labels(case_run, nodes) if lab is not None}
 
 
-def _resolve_response(response: str, case: Case) -> str:
+def resolve_response(response: str, case: Case) -> str:
     """A user's response name -> a point label (package docstring)."""
     if response in case.nodes or "@" in response:
         if "@" in response:
@@ -225,7 +225,7 @@ def _resolve_response(response: str, case: Case) -> str:
                      "<cable>@<fraction> or a mesh node <cable>.<k> of the case file's mesh")
 
 
-def _common_points(cases: Sequence[Case]) -> set[str]:
+def common_points(cases: Sequence[Case]) -> set[str]:
     common = None
     for c in cases:
         pts = _mesh_points(c)

@@ -9,7 +9,7 @@ import numpy as np
 from catdae._xr import xr
 from catdae.case import Step
 from catdae.study import quantity
-from catdae.study.core import _CHOICES, _COORD_META, _COUNTS, _MEMORY_NAMES
+from catdae.study.core import CHOICES, COORD_META, COUNTS, MEMORY_NAMES
 
 
 def _motion(ref: xr.Dataset, label: str) -> float:
@@ -30,10 +30,10 @@ def _transient_error(run_ds: xr.Dataset, ref: xr.Dataset, label: str) -> float:
     return float(np.linalg.norm(ui - u_ref[inside], axis=1).max())
 
 
-def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
+def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     names = list(grid)
     shape = tuple(len(v) for v in grid.values())
-    data = {v: np.full(shape, np.nan) for v in ("wall_time", *_COUNTS, "peak_memory", "error",
+    data = {v: np.full(shape, np.nan) for v in ("wall_time", *COUNTS, "peak_memory", "error",
                                                 "peak_tension_error")}
     status = np.full(shape, "", dtype=object)
     ref_ok = ref.attrs.get("status", "completed") == "completed"
@@ -50,7 +50,7 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
         idx = tuple(grid[n].index(combo[n]) for n in names)
         rec = records[key]
         status[idx] = str(rec.attrs["status"])
-        for v in ("wall_time", *_COUNTS, "peak_memory"):
+        for v in ("wall_time", *COUNTS, "peak_memory"):
             data[v][idx] = float(rec.attrs.get(v, math.nan))
         if status[idx] != "completed" or not ref_ok:
             continue
@@ -69,13 +69,13 @@ def _assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     dims = tuple(names)
     coords = {}
     for n in names:
-        vals = np.array(grid[n], dtype=object if n in _CHOICES else None)
-        units, long_name = _COORD_META[n]
+        vals = np.array(grid[n], dtype=object if n in CHOICES else None)
+        units, long_name = COORD_META[n]
         coords[n] = xr.Variable(n, vals, {"units": units, "long_name": long_name} if units
                                 else {"long_name": long_name})
     methods = sorted({str(r.attrs.get("memory_method", "")) for r in records.values()} - {""})
     memory = "+".join(methods)
-    mem_name = "; ".join(_MEMORY_NAMES[m] for m in methods)
+    mem_name = "; ".join(MEMORY_NAMES[m] for m in methods)
     if st.kind == "transient":
         err_units, err_name = "m", (f"largest distance over time between the displacement at "
                                     f"{label} and the reference's")

@@ -23,21 +23,21 @@ from catdae.case.names import cable_of
 from catdae.errors import CaseError
 from catdae.interrupts import deferred
 from catdae.study.core import (
-    _COUNTS,
+    COUNTS,
     StudyError,
-    _common_points,
-    _resolve_response,
+    common_points,
     configure,
     point_labels,
     reference_settings,
+    resolve_response,
     run_key,
     settings_grid,
     study_step,
 )
-from catdae.study.dataset import _assemble
+from catdae.study.dataset import assemble
 from catdae.study.quantity import frequency_target, static_target, static_values
-from catdae.study.store import _clean, _store_read, _store_write
-from catdae.study.worker import _MemoryProbe, peak_tension
+from catdae.study.store import clean, store_read, store_write
+from catdae.study.worker import MemoryProbe, peak_tension
 
 
 def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
@@ -78,7 +78,7 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         ref_case = None if given_ref else configure(case, st.name, ref_settings, duration)
     except CaseError as exc:
         raise StudyError(f"a setting of the study makes the case invalid:\n{exc}") from None
-    _MemoryProbe(memory)  # reject an unknown method before anything runs
+    MemoryProbe(memory)  # reject an unknown method before anything runs
     keys = [run_key(c, st.name, memory) for c in run_cases]
     ref_data = _given_reference(reference, st, case) if given_ref else None
     if st.kind == "transient":
@@ -98,7 +98,7 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
     todo: dict[str, Case] = {}
     for key, c in ([(ref_key, ref_case)] if ref_key else []) + list(zip(keys, run_cases,
                                                                           strict=True)):
-        stored = _store_read(store_dir, key) if store_dir is not None else None
+        stored = store_read(store_dir, key) if store_dir is not None else None
         if stored is not None:
             records[key] = stored
         else:
@@ -109,7 +109,7 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         for key, ds in _execute_all(todo, st.name, memory, scheduler, workers):
             if store_dir is not None and not ds.attrs.get("lost"):
                 with deferred():  # a signal waits until the stored run is complete
-                    _store_write(store_dir, key, ds, by_key.get(key, ref_settings))
+                    store_write(store_dir, key, ds, by_key.get(key, ref_settings))
             records[key] = ds
             if on_run is not None:
                 on_run(by_key.get(key), ds)
@@ -119,12 +119,12 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         not_run = {"status": "not run (the study was interrupted"
                    + (f" by {signal.Signals(why).name})" if why else ")"),
                    "wall_time": math.nan, "peak_memory": math.nan,
-                   **{k: math.nan for k in _COUNTS}}
+                   **{k: math.nan for k in COUNTS}}
         for key in [*([ref_key] if ref_key else []), *keys]:
             records.setdefault(key, xr.Dataset(attrs=dict(not_run)))
     ref = ref_data if ref_data is not None else records[ref_key]
-    out = _assemble(grid, combos, keys, records, ref, st, target)
-    out.attrs.update(_clean({
+    out = assemble(grid, combos, keys, records, ref, st, target)
+    out.attrs.update(clean({
         "title": case.title, "case_name": case.name, "step": st.name, "step_kind": st.kind,
         "duration": duration if duration is not None else st.duration,
         "catdae_version": __version__, "created": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -153,11 +153,11 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
 def _transient_target(case: Case, run_cases: list[Case], response, grid,
                       given_points: set[str] | None) -> str | list[str]:
     """The response point, or the candidates when the reference is to choose (package doc)."""
-    common = _common_points(run_cases)
+    common = common_points(run_cases)
     if given_points is not None:
         common &= given_points
     if response is not None:
-        label = _resolve_response(str(response), case)
+        label = resolve_response(str(response), case)
         if label not in common:
             raise StudyError(f"response {response!r} ({label}) is not a node of every mesh of "
                              f"the study (elements {grid['elements']} and the reference); "
@@ -248,7 +248,7 @@ def _execute_all(todo: Mapping[str, Case], step_name: str, memory: str, schedule
                 ds = xr.Dataset(attrs={"status": f"error: {type(exc).__name__}: {exc}",
                                        "lost": 1, "wall_time": math.nan,
                                        "peak_memory": math.nan,
-                                       **{k: math.nan for k in _COUNTS}})
+                                       **{k: math.nan for k in COUNTS}})
             fut.release()
             yield key, ds
 

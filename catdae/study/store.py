@@ -14,7 +14,7 @@ from catdae.output.results import write_atomic
 from catdae.study.core import STORE_FORMAT
 
 
-def _store_read(store: Path, key: str) -> xr.Dataset | None:
+def store_read(store: Path, key: str) -> xr.Dataset | None:
     path = store / f"{key}.nc"
     if not path.exists():
         return None
@@ -27,7 +27,7 @@ def _store_read(store: Path, key: str) -> xr.Dataset | None:
     return ds
 
 
-def _store_write(store: Path, key: str, ds: xr.Dataset, settings: Mapping | None) -> None:
+def store_write(store: Path, key: str, ds: xr.Dataset, settings: Mapping | None) -> None:
     """Atomically: a temporary file moved into place, so a crash never leaves half a run."""
     out = ds.copy()
     out.attrs.update(key=key, store_format=STORE_FORMAT,
@@ -39,5 +39,5 @@ def _plain(v):
     return v.item() if isinstance(v, np.generic) else v
 
 
-def _clean(attrs: dict) -> dict:
+def clean(attrs: dict) -> dict:
     return {k: _plain(v) for k, v in attrs.items() if v is not None}

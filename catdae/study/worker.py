@@ -12,7 +12,7 @@ from catdae._xr import xr
 from catdae.analysis import run
 from catdae.case import AXES, Case, Step
 from catdae.errors import CatdaeError
-from catdae.study.core import _COUNTS, StudyError, point_labels
+from catdae.study.core import COUNTS, StudyError, point_labels
 
 _WARMED: set[tuple] = set()  # kinds of step already run once in this process
 
@@ -38,7 +38,7 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
     index = [s.name for s in case_run.steps].index(step_name)
     before = case_run.steps[index - 1].name if index else None
     group, status = None, "completed"
-    with _MemoryProbe(memory) as probe:
+    with MemoryProbe(memory) as probe:
         t0 = time.perf_counter()
         try:
             group = run(case_run, on_group=on_group, progress=False)[step_name].to_dataset()
@@ -52,7 +52,7 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
     wall = marks.get(step_name, t1) - start if before is None or before in marks else math.nan
     attrs = {"status": status, "wall_time": wall, "peak_memory": probe.peak,
              "memory_method": probe.method, "step_kind": step.kind}
-    for k in _COUNTS:
+    for k in COUNTS:
         v = group.attrs.get(k) if group is not None else None
         attrs[k] = float(v) if v is not None else math.nan
     if group is None or status != "completed":
@@ -92,7 +92,7 @@ def _warm_up(case_run: Case, step: Step) -> None:
         pass  # the timed run reports it
 
 
-class _MemoryProbe:
+class MemoryProbe:
     """Peak memory of a block in bytes, and the method that measured it (package docstring):
     ``peak_rss`` (VmHWM reset, Linux), ``maxrss`` (lifetime peak) or ``tracemalloc``."""
 

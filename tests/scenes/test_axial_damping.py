@@ -19,58 +19,26 @@ import pytest
 
 import catdae
 
+from scene_toml import cable_scene, falling_mass, load, point_mass, step
+
 G = 9.81
 
 
-def _bar(ratio_line: str, *, M=100.0, L0=10.0, EA=1e6, stretch=0.02, push=1e-3,
+def _bar(damping=None, *, M=100.0, L0=10.0, EA=1e6, stretch=0.02, push=1e-3,
          duration=2.0) -> str:
     """A weightless bar A-B along x, B free along x only, a mass M at B held ``stretch`` m
     beyond L0 by a constant load; a second load pushes it ``push`` m further, then is removed
-    (free axial vibration about the stretched state)."""
+    (free axial vibration about the stretched state). ``damping``: the transient's
+    ``axial_damping`` table (None: none)."""
     k = EA / L0
-    return f"""
-gravity = 0.0
-[materials.bar]
-EA = {EA!r}
-mass = {1e-6 * M / L0!r}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [{L0 + stretch!r}, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = ["y", "z"]
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "bar"
-length = {L0!r}
-elements = 1
-[[point_masses]]
-name = "m"
-node = "B"
-mass = {M!r}
-[[loads]]
-name = "pre"
-node = "B"
-force = [{k * stretch!r}, 0.0, 0.0]
-[[loads]]
-name = "push"
-node = "B"
-force = [{k * push!r}, 0.0, 0.0]
-[[steps]]
-kind = "static"
-name = "pushed"
-[[steps]]
-kind = "transient"
-name = "free"
-remove = ["push"]
-mass_model = "lumped"
-duration = {duration!r}
-output_interval = 0.002
-rtol = 1e-9
-atol = 1e-12
-{ratio_line}
-"""
+    return cable_scene(
+        B=(L0 + stretch, 0.0, 0.0), L0=L0, EA=EA, mass=1e-6 * M / L0, elements=1, gravity=0.0,
+        material="bar", supports=("A", 'B = ["y", "z"]'),
+        extra=(point_mass("m", M, node="B") + load("pre", [k * stretch, 0.0, 0.0], node="B")
+               + load("push", [k * push, 0.0, 0.0], node="B")),
+        steps=step("static", "pushed") + step(
+            "transient", "free", remove=["push"], mass_model="lumped", duration=duration,
+            output_interval=0.002, rtol=1e-9, atol=1e-12, axial_damping=damping))
 
 
 def _log_decrement_ratio(t, x):
@@ -92,8 +60,7 @@ def test_damping_ratio_of_a_mass_on_a_bar(scale):
     is recovered; stated at twice it, half of it."""
     M, L0, EA, zeta = 100.0, 10.0, 1e6, 0.02
     f_n = math.sqrt(EA / L0 / M) / (2 * math.pi)  # the rope's mass is 1e-6 of M
-    line = f"axial_damping = {{ ratio = {zeta!r}, frequency = {scale * f_n!r} }}"
-    ds = catdae.run(_bar(line))["free"].to_dataset()
+    ds = catdae.run(_bar({"ratio": zeta, "frequency": scale * f_n}))["free"].to_dataset()
     assert ds.attrs["status"] == "completed"
     assert ds.attrs["axial_damping"].startswith("2 % of critical")
     x = ds.position.sel(node="B", axis="x").values
@@ -104,49 +71,23 @@ def test_damping_ratio_of_a_mass_on_a_bar(scale):
 def test_no_axial_damping_no_decay():
     """Without the field the same oscillator keeps its amplitude (the decay above is the
     damping's, not the integrator's)."""
-    ds = catdae.run(_bar(""))["free"].to_dataset()
+    ds = catdae.run(_bar())["free"].to_dataset()
     assert ds.attrs["axial_damping"] == "none"
     x = ds.position.sel(node="B", axis="x").values
     assert abs(_log_decrement_ratio(ds.time.values, x)) < 2e-4
 
 
-def _pendulum(line: str, *, duration: float) -> str:
+def _pendulum(damping, *, duration: float) -> str:
+    """A 100 kg bob on a 10 m line (2 elements, 1e-4 of its mass), held 0.1 rad aside by a load
+    that the transient "swing" removes; ``damping``: its ``axial_damping`` table (None: none)."""
     M, L0, EA = 100.0, 10.0, 1e8
-    return f"""
-[materials.line]
-EA = {EA!r}
-mass = 0.01
-weight = 0.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [0.0, 0.0, -10.01]
-[supports]
-A = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "line"
-length = {L0!r}
-elements = 2
-[[point_masses]]
-name = "bob"
-node = "B"
-mass = {M!r}
-[[loads]]
-name = "hold"
-node = "B"
-force = [{M * G * 0.1!r}, 0.0, 0.0]
-[[steps]]
-kind = "static"
-name = "held"
-[[steps]]
-kind = "transient"
-name = "swing"
-remove = ["hold"]
-duration = {duration!r}
-output_interval = 0.02
-{line}
-"""
+    return cable_scene(
+        B=(0.0, 0.0, -10.01), L0=L0, EA=EA, mass=0.01, weight=0.0, elements=2,
+        supports=("A",), material="line",
+        extra=point_mass("bob", M, node="B") + load("hold", [M * G * 0.1, 0.0, 0.0], node="B"),
+        steps=step("static", "held") + step("transient", "swing", remove=["hold"],
+                                            duration=duration, output_interval=0.02,
+                                            axial_damping=damping))
 
 
 def test_swing_is_not_damped():
@@ -156,8 +97,8 @@ def test_swing_is_not_damped():
     strain mode excited by the release, is what is damped)."""
     period = 2 * math.pi * math.sqrt(10.0 / G)
     amps = []
-    for line in ("", 'axial_damping = { ratio = 0.5, frequency = "element" }'):
-        ds = catdae.run(_pendulum(line, duration=3.2 * period))["swing"].to_dataset()
+    for damping in (None, {"ratio": 0.5, "frequency": "element"}):
+        ds = catdae.run(_pendulum(damping, duration=3.2 * period))["swing"].to_dataset()
         assert ds.attrs["status"] == "completed"
         x = ds.position.sel(node="B", axis="x")
         amps.append(float(np.abs(x.sel(time=slice(2.5 * period, None))).max()) / float(x[0]))
@@ -173,30 +114,10 @@ def test_velocity_block_matches_finite_differences():
     from catdae.model.mesh import build_mesh
     from catdae.solvers.residual import TransientProblem
 
-    text = """
-[materials.w]
-EA = 1e6
-mass = 2.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [9.0, 1.0, -2.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "w"
-length = 10.0
-elements = 3
-[[steps]]
-kind = "transient"
-name = "t"
-mass_model = "lumped"
-duration = 1.0
-output_interval = 0.1
-axial_damping = { ratio = 0.3, frequency = 5.0 }
-"""
+    text = cable_scene(
+        B=(9.0, 1.0, -2.0), L0=10.0, EA=1e6, mass=2.0, elements=3, material="w",
+        steps=step("transient", "t", mass_model="lumped", duration=1.0, output_interval=0.1,
+                   axial_damping={"ratio": 0.3, "frequency": 5.0}))
     case = catdae.load_case(text)
     mesh = build_mesh(case)
     model = Model(case, mesh, set(), mass_model="lumped")
@@ -229,35 +150,10 @@ axial_damping = { ratio = 0.3, frequency = 5.0 }
 # ------------------------------------------------------------------------------------------------
 # the tension envelope
 # ------------------------------------------------------------------------------------------------
-def _drop(ratio: float, *, x_off=0.3, M=1000.0, L0=10.0, EA=1e7, fall=0.5) -> str:
-    """A mass M on a slack rope (one element, mass ``ratio`` M), released from rest ``fall``
-    m below the taut length; B is ``x_off`` m aside so that the slack rope has a shape."""
-    return f"""
-[materials.rope]
-EA = {EA!r}
-mass = {ratio * M / L0!r}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [{x_off!r}, 0.0, {-(L0 - fall)!r}]
-[supports]
-A = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "rope"
-length = {L0!r}
-elements = 1
-[[point_masses]]
-name = "bob"
-node = "B"
-mass = {M!r}
-[[steps]]
-kind = "transient"
-name = "drop"
-mass_model = "lumped"
-duration = 1.0
-output_interval = 0.05
-"""
+def _drop(ratio: float, *, M=1000.0, L0=10.0) -> str:
+    """``scene_toml.falling_mass`` with the rope's mass ``ratio`` M: a mass M on a slack rope,
+    released from rest 0.5 m below the taut length, B 0.3 m aside."""
+    return falling_mass(ratio * M / L0, duration=1.0, M=M, L0=L0)
 
 
 def test_falling_mass_snap_from_the_envelope():
@@ -286,7 +182,7 @@ def test_falling_mass_snap_from_the_envelope():
 def test_envelope_holds_every_output():
     """tension_max >= tension at every output, tension_min <= it, their times inside the step;
     for a free vibration the envelope is at least the outputs' extremes and close to them."""
-    ds = catdae.run(_bar("", duration=0.5))["free"].to_dataset()
+    ds = catdae.run(_bar(duration=0.5))["free"].to_dataset()
     T = ds.tension.values
     assert np.all(ds.tension_max.values >= T.max(axis=0))
     assert np.all(ds.tension_min.values <= T.min(axis=0))
@@ -304,37 +200,13 @@ def test_note_on_a_load_removed_from_a_slack_cable():
     note says the wave it sends is not fully carried, and names the load; with the lumped mass,
     or on a taut cable, there is nothing to say."""
     def case(length, mass_model):
-        mm = "" if mass_model is None else f'mass_model = "{mass_model}"\n'
-        return f"""
-[materials.wire]
-EA = 3.4e7
-mass = 5.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "wire"
-length = {length!r}
-elements = 6
-[[loads]]
-name = "lift"
-node = "c.3"
-force = [0.0, 0.0, 300.0]
-[[steps]]
-kind = "static"
-name = "held"
-[[steps]]
-kind = "transient"
-name = "let go"
-remove = ["lift"]
-duration = 0.01
-output_interval = 0.005
-{mm}"""
+        return cable_scene(
+            B=(10.0, 0.0, 0.0), L0=length, EA=3.4e7, mass=5.0, elements=6, material="wire",
+            extra=load("lift", [0.0, 0.0, 300.0], node="c.3"),
+            steps=step("static", "held") + step("transient", "let go", remove=["lift"],
+                                                duration=0.01, output_interval=0.005,
+                                                mass_model=mass_model))
+
     ds = catdae.run(case(15.0, None))["let go"].to_dataset()
     assert ds.attrs["mass_model"] == "blended"
     assert "'lift' added or removed" in ds.attrs["note"] and "lumped" in ds.attrs["note"]

@@ -13,35 +13,17 @@ from catdae.cli import main
 from catdae.errors import CaseError
 
 from reference import irvine_catenary
+from scene_toml import cable_scene, section, static_step, step
 
 EA, MASS, G, L0 = 2.0e7, 2.0, 9.81, 104.0
 
-CASE = f"""
-[materials.m]
-EA = {EA!r}
-mass = {MASS!r}
-[nodes]
-A = [0.0, 0.0, 30.0]
-B = [100.0, 0.0, 50.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = {L0!r}
-elements = 8
-{{ground}}
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "transient"
-name = "sway"
-duration = 0.3
-output_interval = 0.01
-"""
+def case(ground: dict, gravity=None) -> str:
+    """The span from A (z = 30 m) to B (100 m along, 20 m up) over a ``[ground]`` of the given
+    fields: a static step "st" and a short transient "sway"."""
+    return cable_scene(A=(0.0, 0.0, 30.0), B=(100.0, 0.0, 50.0), L0=L0, EA=EA, mass=MASS,
+                       elements=8, gravity=gravity, extra=section("ground", **ground),
+                       steps=static_step("st") + step("transient", "sway", duration=0.3,
+                                                      output_interval=0.01))
 
 
 def least_gap(ground):
@@ -60,12 +42,12 @@ def least_gap(ground):
 
 
 @pytest.mark.parametrize(("table", "ground"), [
-    ("[ground]\nelevation = 12.5", lambda x: 12.5),
-    ("[ground]\nx = [-10.0, 40.0, 120.0]\nz = [5.0, 20.0, 33.0]",
+    ({"elevation": 12.5}, lambda x: 12.5),
+    ({"x": [-10.0, 40.0, 120.0], "z": [5.0, 20.0, 33.0]},
      lambda x: float(np.interp(x, [-10.0, 40.0, 120.0], [5.0, 20.0, 33.0]))),
 ])
 def test_clearance_against_the_catenary(table, ground):
-    tree = catdae.run(catdae.load_case(CASE.format(ground=table)), progress=False)
+    tree = catdae.run(catdae.load_case(case(table)), progress=False)
     st = tree["st"].ds.sel(cable="c")
     gap, s = least_gap(ground)
     assert float(st.clearance) == pytest.approx(gap, rel=1e-9)
@@ -80,15 +62,15 @@ def test_clearance_against_the_catenary(table, ground):
 
 
 @pytest.mark.parametrize(("table", "where", "words"), [
-    ("[ground]\nelevation = 1.0\nx = [0.0, 1.0]\nz = [0.0, 0.0]", "ground", "not both"),
-    ("[ground]", "ground", "not neither"),
-    ("[ground]\nx = [0.0, 1.0]", "ground.z", "missing"),
-    ("[ground]\nx = [0.0, 0.0]\nz = [1.0, 2.0]", "ground.x", "strictly increasing"),
-    ("[ground]\nx = [0.0, 1.0, 2.0]\nz = [1.0, 2.0]", "ground", "same length"),
+    ({"elevation": 1.0, "x": [0.0, 1.0], "z": [0.0, 0.0]}, "ground", "not both"),
+    ({}, "ground", "not neither"),
+    ({"x": [0.0, 1.0]}, "ground.z", "missing"),
+    ({"x": [0.0, 0.0], "z": [1.0, 2.0]}, "ground.x", "strictly increasing"),
+    ({"x": [0.0, 1.0, 2.0], "z": [1.0, 2.0]}, "ground", "same length"),
 ])
 def test_bad_grounds(table, where, words, tmp_path, capsys):
     path = tmp_path / "bad.toml"
-    path.write_text(CASE.format(ground=table))
+    path.write_text(case(table))
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert f"{where}:" in err and words in err, err
@@ -97,8 +79,6 @@ def test_bad_grounds(table, where, words, tmp_path, capsys):
 
 
 def test_a_profile_needs_gravity_along_minus_z():
-    text = "gravity = [0.0, -9.81, 0.0]\n" + CASE.format(
-        ground="[ground]\nx = [0.0, 1.0]\nz = [0.0, 0.0]").replace(
-        'B = "pinned"', 'B = "pinned"')
+    text = case({"x": [0.0, 1.0], "z": [0.0, 0.0]}, gravity=[0.0, -9.81, 0.0])
     with pytest.raises(CaseError, match="needs gravity along -z"):
         catdae.load_case(text)

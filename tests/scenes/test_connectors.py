@@ -14,38 +14,14 @@ import catdae
 from catdae.case import case_from_dict
 
 from reference import damper_sag_reduction, string_with_damper
-from scene_toml import cable_scene
+from scene_toml import bar, cable, cable_scene, damper, load, point_mass, scene, static_step, step
 
-STRUT = """title = "cable and strut"
-[materials]
-tie = { EA = 2.0e7, mass = 0.0 }
-[nodes]
-W1 = [0.0, 0.0, 0.0]
-W2 = [0.0, 0.0, 3.0]
-J = [4.0, 0.0, 0.0]
-[supports]
-W1 = "pinned"
-W2 = "pinned"
-J = ["y"]
-[[cables]]
-name = "tie"
-ends = ["W2", "J"]
-material = "tie"
-length = 4.99
-[[bars]]
-name = "strut"
-ends = ["W1", "J"]
-EA = 5.0e7
-mass = 10.0
-length = 4.0
-[[loads]]
-name = "P"
-node = "J"
-force = [0.0, 0.0, -1.0e4]
-[[steps]]
-kind = "static"
-name = "st"
-"""
+STRUT = scene(head={"title": "cable and strut"}, materials={"tie": {"EA": 2.0e7, "mass": 0.0}},
+              nodes={"W1": (0.0, 0.0, 0.0), "W2": (0.0, 0.0, 3.0), "J": (4.0, 0.0, 0.0)},
+              supports=("W1", "W2", 'J = ["y"]'), cables=cable("tie", ("W2", "J"), "tie", 4.99),
+              extra=(bar("strut", ["W1", "J"], 5.0e7, mass=10.0, length=4.0)
+                     + load("P", [0.0, 0.0, -1.0e4], node="J")),
+              steps=static_step("st"))
 
 
 def test_bar_in_a_cable_and_strut_system_matches_the_hand_calculation():
@@ -86,29 +62,12 @@ def pendulum(theta_offset=10.0, line=100.5, mass=1e5, EA=1e9, g=9.81):
     theta0 = np.arcsin(theta_offset / line)
     rest = float(line / (1.0 + mass * g * np.cos(theta0) / EA))
     z = -float(np.sqrt(line**2 - theta_offset**2))
-    text = f"""title = "pendulum"
-gravity = {g}
-[nodes]
-top = [0.0, 0.0, 0.0]
-bob = [{theta_offset}, 0.0, {z!r}]
-[supports]
-top = "pinned"
-bob = ["y"]
-[[bars]]
-name = "line"
-ends = ["top", "bob"]
-EA = {EA}
-length = {rest!r}
-[[point_masses]]
-name = "bob"
-node = "bob"
-mass = {mass}
-[[steps]]
-kind = "transient"
-name = "swing"
-duration = 101.0
-output_interval = 0.1
-"""
+    text = scene(head={"title": "pendulum", "gravity": g}, materials={},
+                 nodes={"top": (0.0, 0.0, 0.0), "bob": (theta_offset, 0.0, z)},
+                 supports=("top", 'bob = ["y"]'), cables="",
+                 extra=bar("line", ["top", "bob"], EA, length=rest) + point_mass("bob", mass,
+                                                                                 node="bob"),
+                 steps=step("transient", "swing", duration=101.0, output_interval=0.1))
     return text, theta0
 
 
@@ -145,10 +104,8 @@ def stay(a_over_l: float, direction: str, elements: int = 100, length: float = 9
 
     k = int(round(a_over_l * elements))
     text = cable_scene(B=(100.0, 0.0, 0.0), L0=length, EA=EA, mass=1.0, elements=elements,
-                       extra=f'[[dampers]]\nname = "d"\nends = ["c.{k}", "G"]\n'
-                             "coefficient = 1.0\n").replace(
-        "[supports]\n", '[supports]\nG = "pinned"\n').replace(
-        "[nodes]\n", "[nodes]\nG = [0.0, 0.0, 0.0]\n")
+                       nodes={"G": (0.0, 0.0, 0.0)}, supports=("G", "A", "B"),
+                       extra=damper("d", [f"c.{k}", "G"], 1.0))
     case = case_from_dict(tomllib.loads(text))
     node = build_mesh(case).X0[build_mesh(case).node_index(f"c.{k}")]
     offset = {"y": (0.0, 2.0, 0.0), "z": (0.0, 0.0, -2.0)}[direction]

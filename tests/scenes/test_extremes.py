@@ -23,7 +23,6 @@ import math
 import signal
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -34,7 +33,7 @@ import catdae.analysis
 from catdae.cli import main
 
 import scene_toml
-from processes import catdae_process, signal_when, transient_runs
+from processes import interrupted_run, long_case
 from reference import (
     irvine_catenary,
     irvine_catenary_inclined_3d,
@@ -42,7 +41,7 @@ from reference import (
     taut_string_frequencies,
 )
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, load, long_transient, modal_step, static_step, transient_step
+from scene_toml import cable_scene, load, modal_step, static_step
 
 G = 9.81
 
@@ -65,8 +64,10 @@ def modal(n: int) -> str:
     return modal_step(n)
 
 
-def transient(duration, dt, *, rtol=1e-8, atol=1e-10, remove=()) -> str:
-    return transient_step("dyn", duration, dt, rtol=rtol, atol=atol, remove=list(remove))
+def transient(duration, dt, *, rtol=1e-8, atol=1e-10, remove=(), mass_model=None) -> str:
+    return scene_toml.step("transient", "dyn", remove=list(remove), duration=float(duration),
+                           output_interval=float(dt), rtol=float(rtol), atol=float(atol),
+                           mass_model=mass_model)
 
 
 def point_mass(name, s, m) -> str:
@@ -301,7 +302,7 @@ def test_point_load_100_times_the_weight_is_two_catenaries_in_equilibrium():
 # vertical: the plumb line
 # ------------------------------------------------------------------------------------------------
 PLUMB_L, PLUMB_M, PLUMB_m = 20.0, 100.0, 1e-3
-BOB = '[[point_masses]]\nname = "bob"\nnode = "B"\nmass = 100.0\n'
+BOB = scene_toml.point_mass("bob", PLUMB_M, node="B")
 
 
 def plumb(zB, ne=4, xB=0.0):
@@ -329,8 +330,7 @@ def _check_plumb(tree, ne):
     np.testing.assert_allclose(f, pendulum, rtol=1e-3)
 
 
-SHAKE_TOP = ('[[support_motions]]\nnode = "A"\n'
-             'x = { kind = "sine", amplitude = 0.2, frequency = 0.5 }\n')
+SHAKE_TOP = scene_toml.support_motion("A", x={"kind": "sine", "amplitude": 0.2, "frequency": 0.5})
 
 
 @pytest.mark.xfail(strict=True, reason=(
@@ -385,8 +385,7 @@ def _shaken_chain(mass_model):
     """A chain hanging free, its top shaken sideways for 1 s: the sideways disturbance needs
     2 sqrt(L/g) = 2.86 s to reach the free end, which must not move sideways yet; the
     work-energy theorem ΔE = ∫ R·v_A dt must hold."""
-    steps = STATIC + transient(1.0, 0.002, rtol=1e-6, atol=1e-8).replace(
-        'kind = "transient"', f'kind = "transient"\nmass_model = "{mass_model}"')
+    steps = STATIC + transient(1.0, 0.002, rtol=1e-6, atol=1e-8, mass_model=mass_model)
     text = scene(B=(0.0, 0.0, -20.02), L0=20.0, EA=1e7, mass=1.0, elements=10, supports=("A",),
                  extra=SHAKE_TOP, steps=steps)
     ds = catdae.run(text)["dyn"].to_dataset()
@@ -477,16 +476,25 @@ def test_release_stays_finite_and_conserves_energy(kind):
     np.testing.assert_array_equal(ds.displacement.sel(node=["A", "B"]).values, 0.0)
 
 
-def test_taut_cable_free_vibration_keeps_its_amplitude_over_100_periods():
+def _taut_release(n_per, per_out, *, rtol, atol, more_steps=""):
+    """A weightless taut cable (span 10 m, 10 % strain: the axial modes only ~3 times faster
+    than the lateral ones; 2 elements) pushed sideways at c.1 by 1 N, then released for
+    ``n_per`` periods of the taut string's fundamental, ``per_out`` outputs a period.
+    Returns (TOML text, span, tension, period)."""
     span, EA, m, ne = 10.0, 1e4, 2.0, 2
-    L0 = span / 1.1  # 10 % strain: the axial modes are only ~3 times faster
+    L0 = span / 1.1
     T = EA * (span / L0 - 1)
     period = 1 / taut_string_frequencies(span, T, m * L0 / span, 1)[0]
-    n_per, per_out = 100, 40
     text = scene(B=(span, 0, 0), L0=L0, EA=EA, mass=m, weight=0.0, elements=ne,
                  extra=node_load("push", "c.1", (0.0, 1.0, 0.0)),
-                 steps=STATIC + transient(n_per * period, period / per_out, rtol=1e-5,
-                                          atol=1e-8, remove=["push"]))
+                 steps=STATIC + transient(n_per * period, period / per_out, rtol=rtol,
+                                          atol=atol, remove=["push"]) + more_steps)
+    return text, span, T, period
+
+
+def test_taut_cable_free_vibration_keeps_its_amplitude_over_100_periods():
+    n_per, per_out = 100, 40
+    text, span, T, period = _taut_release(n_per, per_out, rtol=1e-5, atol=1e-8)
     tree = catdae.run(text)
     assert_sound(tree)
     ds = tree["dyn"].to_dataset()
@@ -504,16 +512,9 @@ def test_taut_cable_free_vibration_keeps_its_amplitude_over_100_periods():
 def test_taut_cable_free_vibration_over_1000_periods():
     """1000 fundamental periods: the frequency read from the whole record equals the modal
     step's (phase kept to 1 % of a period after 1000), and amplitude and energy hold to 1 %."""
-    span, EA, m, ne = 10.0, 1e4, 2.0, 2
-    L0 = span / 1.1
-    T = EA * (span / L0 - 1)
-    period = 1 / taut_string_frequencies(span, T, m * L0 / span, 1)[0]
     n_per, per_out = 1000, 8
-    text = scene(B=(span, 0, 0), L0=L0, EA=EA, mass=m, weight=0.0, elements=ne,
-                 extra=node_load("push", "c.1", (0.0, 1.0, 0.0)),
-                 steps=STATIC + transient(n_per * period, period / per_out, rtol=1e-7,
-                                          atol=1e-10, remove=["push"])
-                 + '[[steps]]\nkind = "modal"\nname = "modes"\nmodes = 1\n')
+    text, _, _, period = _taut_release(n_per, per_out, rtol=1e-7, atol=1e-10,
+                                       more_steps=modal(1))
     tree = catdae.run(text)
     ds = tree["dyn"].to_dataset()
     assert ds.attrs["status"] == "completed"
@@ -780,11 +781,6 @@ def test_bad_input_through_python_m_catdae(tmp_path, command):
 # ------------------------------------------------------------------------------------------------
 # nothing lost: interruptions
 # ------------------------------------------------------------------------------------------------
-def _long_case(path: Path, duration=1000.0) -> Path:
-    path.write_text(long_transient(duration))
-    return path
-
-
 def test_interrupted_transient_in_process_keeps_results(tmp_path, monkeypatch, capsys):
     """KeyboardInterrupt inside IDA after 30 steps: exit 130, the earlier output file is kept,
     the partial results go to <stem>.failed.nc with a status that says why."""
@@ -802,7 +798,7 @@ def test_interrupted_transient_in_process_keeps_results(tmp_path, monkeypatch, c
             return super().step(*args, **kwargs)
 
     monkeypatch.setattr(transient, "IDA", Interrupting)
-    case = _long_case(tmp_path / "long.toml")
+    case = long_case(tmp_path / "long.toml")
     out = tmp_path / "long.nc"
     out.write_bytes(b"previous results")
     code = main(["run", str(case), "-o", str(out), "--no-progress"])
@@ -840,11 +836,9 @@ def test_interrupted_modal_step_keeps_the_static_results(tmp_path, monkeypatch, 
 
 def test_sigint_during_a_long_transient(tmp_path):
     """A real Ctrl-C (SIGINT) to ``python -m catdae run`` while the transient runs."""
-    case = _long_case(tmp_path / "long.toml")
     out = tmp_path / "long.nc"
     out.write_bytes(b"previous results")
-    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], tmp_path)
-    code, err = signal_when(proc, signal.SIGINT, transient_runs)
+    code, err, _ = interrupted_run(tmp_path, signal.SIGINT, out)
     assert code == 130, err
     assert "Traceback" not in err
     assert "catdae: interrupted by SIGINT" in err

@@ -15,26 +15,25 @@ from catdae.cli import main
 from catdae.errors import CaseError
 
 from reference import irvine_catenary
+from scene_toml import cable, distributed_load, scene, static_step, step
 
 EA, MASS, G, ICE = 2.0e7, 1.6, 9.81, 12.0  # N, kg/m, m/s², N/m
 
 
-def iced(form: str, coverage: str = "") -> str:
-    return (f"[materials.s]\nEA = {EA!r}\nmass = {MASS!r}\n"
-            "[nodes]\nA = [0.0, 0.0, 0.0]\nB = [200.0, 0.0, 10.0]\n"
-            '[supports]\nA = "pinned"\nB = "pinned"\n'
-            f'[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "s"\n{form}\n'
-            "elements = 16\n"
-            f'[[distributed_loads]]\nname = "ice"\ncable = "c"\nload = [0.0, 0.0, {-ICE!r}]\n'
-            f"{coverage}"
-            '[[steps]]\nkind = "static"\nname = "iced"\n'
-            '[[steps]]\nkind = "static"\nname = "bare"\nremove = ["ice"]\n')
+def iced(form: dict, coverage: dict | None = None) -> str:
+    """A 200 m span strung to ``form`` under ice over the whole cable (or over ``coverage``:
+    from_s, to_s): the static step "iced", then "bare" with the ice removed."""
+    return scene(materials={"s": {"EA": EA, "mass": MASS}},
+                 nodes={"A": (0.0, 0.0, 0.0), "B": (200.0, 0.0, 10.0)},
+                 cables=cable("c", ("A", "B"), "s", form=form, elements=16),
+                 extra=distributed_load("c", [0.0, 0.0, -ICE], name="ice", **(coverage or {})),
+                 steps=static_step("iced") + step("static", "bare", remove=["ice"]))
 
 
 @pytest.mark.parametrize(("form", "key", "target"), [
-    ("form = { horizontal_tension = 2.0e4 }", "H", 2.0e4),
-    ('form = { tension = 2.2e4, at = "B" }', "T_j", 2.2e4),
-    ("form = { sag = 6.0 }", "sag", 6.0),
+    ({"horizontal_tension": 2.0e4}, "H", 2.0e4),
+    ({"tension": 2.2e4, "at": "B"}, "T_j", 2.2e4),
+    ({"sag": 6.0}, "sag", 6.0),
 ])
 def test_iced_cable_strung_to_a_target(form, key, target, tmp_path):
     case = tmp_path / "iced.toml"
@@ -51,7 +50,7 @@ def test_iced_cable_strung_to_a_target(form, key, target, tmp_path):
 
 
 def test_part_coverage_on_a_found_length_is_refused_clearly():
-    text = iced("form = { horizontal_tension = 2.0e4 }", "from_s = 10.0\nto_s = 50.0\n")
+    text = iced({"horizontal_tension": 2.0e4}, {"from_s": 10.0, "to_s": 50.0})
     with pytest.raises(CaseError) as err:
         catdae.load_case(text)
     msg = str(err.value)

@@ -19,28 +19,28 @@ import catdae
 from catdae.errors import CaseError
 
 from reference import irvine_catenary, irvine_catenary_inclined_3d
+from scene_toml import cable, load, point_mass, scene, static_step, step
 
 EA, MASS, G = 2.0e7, 2.0, 9.81
 W = MASS * G
 
 
-def one_cable(form: str, B=(100.0, 0.0, 20.0), elements=8, extra="", steps=None,
-              supports='A = "pinned"\nB = "pinned"\n'):
-    steps = steps if steps is not None else (
-        '[[steps]]\nkind = "static"\nname = "found"\n'
-        '[[steps]]\nkind = "static"\nname = "again"\n')
-    return (f"[materials.s]\nEA = {EA!r}\nmass = {MASS!r}\n"
-            f"[nodes]\nA = [0.0, 0.0, 0.0]\nB = [{B[0]!r}, {B[1]!r}, {B[2]!r}]\n"
-            f"[supports]\n{supports}"
-            f'[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "s"\n{form}\n'
-            f"elements = {elements}\n{extra}{steps}")
+def one_cable(fields: dict, B=(100.0, 0.0, 20.0), elements=8, extra="", steps=None,
+              weight=None):
+    """Cable c from A to B, both pinned, with the cable ``fields`` (its ``form``, or whatever a
+    bad case gives) in place of a length; by default two static steps, "found" and "again"."""
+    steps = steps if steps is not None else static_step("found") + static_step("again")
+    return scene(materials={"s": {"EA": EA, "mass": MASS, "weight": weight}},
+                 nodes={"A": (0.0, 0.0, 0.0), "B": B},
+                 cables=cable("c", ("A", "B"), "s", **fields, elements=elements),
+                 extra=extra, steps=steps)
 
 
 @pytest.mark.parametrize(("form", "key", "target"), [
-    ("form = { horizontal_tension = 5000.0 }", "H", 5000.0),
-    ('form = { tension = 6000.0, at = "B" }', "T_j", 6000.0),
-    ('form = { tension = 5700.0, at = "A" }', "T_i", 5700.0),
-    ("form = { sag = 3.0 }", "sag", 3.0),
+    ({"form": {"horizontal_tension": 5000.0}}, "H", 5000.0),
+    ({"form": {"tension": 6000.0, "at": "B"}}, "T_j", 6000.0),
+    ({"form": {"tension": 5700.0, "at": "A"}}, "T_i", 5700.0),
+    ({"form": {"sag": 3.0}}, "sag", 3.0),
 ])
 def test_single_cable_target_against_irvine(form, key, target):
     tree = catdae.run(catdae.load_case(one_cable(form)))
@@ -57,9 +57,8 @@ def test_single_cable_target_against_irvine(form, key, target):
 def test_pretension_is_the_straight_member_convention():
     # weightless and taut: the tension is exactly the pretension, L0 = chord / (1 + T/EA)
     T, chord = 3.0e4, math.hypot(10.0, 4.0)
-    text = one_cable("form = { pretension = 3.0e4 }", B=(10.0, 0.0, 4.0), elements=3,
-                     steps='[[steps]]\nkind = "static"\nname = "found"\n'
-                     ).replace("mass = 2.0\n", "mass = 2.0\nweight = 0.0\n")
+    text = one_cable({"form": {"pretension": 3.0e4}}, B=(10.0, 0.0, 4.0), elements=3,
+                     steps=static_step("found"), weight=0.0)
     ds = catdae.run(catdae.load_case(text))["found"].ds
     assert float(ds.unstrained_length[0]) == pytest.approx(chord / (1 + T / EA), rel=1e-14)
     assert ds.tension.values == pytest.approx(T, rel=1e-10)
@@ -68,17 +67,12 @@ def test_pretension_is_the_straight_member_convention():
 def test_a_net_is_found_together():
     # two cables meet at a free node N carrying 200 kg; cable a sets its horizontal tension,
     # cable b its sag: both lengths depend on both targets through N
-    text = (
-        f"[materials.s]\nEA = {EA!r}\nmass = {MASS!r}\n"
-        "[nodes]\nA = [0.0, 0.0, 10.0]\nN = [20.0, 5.0, 0.0]\nB = [45.0, 0.0, 12.0]\n"
-        '[supports]\nA = "pinned"\nB = "pinned"\n'
-        '[[cables]]\nname = "a"\nends = ["A", "N"]\nmaterial = "s"\n'
-        "form = { horizontal_tension = 4000.0 }\nelements = 6\n"
-        '[[cables]]\nname = "b"\nends = ["N", "B"]\nmaterial = "s"\n'
-        "form = { sag = 0.4 }\nelements = 6\n"
-        '[[point_masses]]\nname = "m"\nnode = "N"\nmass = 200.0\n'
-        '[[steps]]\nkind = "static"\nname = "found"\n'
-    )
+    text = scene(materials={"s": {"EA": EA, "mass": MASS}},
+                 nodes={"A": (0.0, 0.0, 10.0), "N": (20.0, 5.0, 0.0), "B": (45.0, 0.0, 12.0)},
+                 cables=[cable("a", ("A", "N"), "s", form={"horizontal_tension": 4000.0},
+                               elements=6),
+                         cable("b", ("N", "B"), "s", form={"sag": 0.4}, elements=6)],
+                 extra=point_mass("m", 200.0, node="N"), steps=static_step("found"))
     ds = catdae.run(catdae.load_case(text))["found"].ds
     L_a, L_b = (float(v) for v in ds.unstrained_length.values)
     X = {n: ds.position.sel(node=n).values for n in ("A", "N", "B")}
@@ -100,10 +94,10 @@ def check_cli(text, tmp_path, *args):
 
 
 @pytest.mark.parametrize(("form", "field", "fragments"), [
-    ('form = { tension = 100.0, at = "B" }', "cables[0].form.tension",
+    ({"form": {"tension": 100.0, "at": "B"}}, "cables[0].form.tension",
      ["cable 'c'", "cannot be reached", "at least"]),
-    ("form = { sag = 1.0e4 }", "cables[0].form.sag", ["cable 'c'", "beyond what the cable"]),
-    ("form = { horizontal_tension = 2.0e7 }", "cables[0].form.horizontal_tension",
+    ({"form": {"sag": 1.0e4}}, "cables[0].form.sag", ["cable 'c'", "beyond what the cable"]),
+    ({"form": {"horizontal_tension": 2.0e7}}, "cables[0].form.horizontal_tension",
      ["cable 'c'", "strain above 50%"]),
 ])
 def test_unreachable_targets_are_invalid_input(form, field, fragments, tmp_path):
@@ -120,36 +114,36 @@ def test_targets_a_net_cannot_reach_together():
     # two cables in series through a free node N with no horizontal load on it: horizontal
     # equilibrium of N makes their horizontal tensions equal, so only equal targets are
     # reachable; each target alone is (the single-cable scan finds a start for both)
-    text = (
-        f"[materials.s]\nEA = {EA!r}\nmass = {MASS!r}\n"
-        "[nodes]\nA = [0.0, 0.0, 0.0]\nN = [20.0, 0.0, -1.0]\nB = [40.0, 0.0, 0.0]\n"
-        '[supports]\nA = "pinned"\nB = "pinned"\nN = ["y"]\n'
-        '[[cables]]\nname = "a"\nends = ["A", "N"]\nmaterial = "s"\n'
-        "form = { horizontal_tension = 1000.0 }\nelements = 2\n"
-        '[[cables]]\nname = "b"\nends = ["N", "B"]\nmaterial = "s"\n'
-        "form = { horizontal_tension = HB }\nelements = 2\n"
-        '[[steps]]\nkind = "static"\nname = "found"\n'
-    )
-    ds = catdae.run(catdae.load_case(text.replace("HB", "1000.0")))["found"].ds
+    def text(h_b):
+        return scene(materials={"s": {"EA": EA, "mass": MASS}},
+                     nodes={"A": (0.0, 0.0, 0.0), "N": (20.0, 0.0, -1.0), "B": (40.0, 0.0, 0.0)},
+                     supports=("A", "B", 'N = ["y"]'),
+                     cables=[cable("a", ("A", "N"), "s", form={"horizontal_tension": 1000.0},
+                                   elements=2),
+                             cable("b", ("N", "B"), "s", form={"horizontal_tension": h_b},
+                                   elements=2)],
+                     steps=static_step("found"))
+
+    ds = catdae.run(catdae.load_case(text(1000.0)))["found"].ds
     assert ds.horizontal_tension.values == pytest.approx(1000.0, rel=1e-8)
     with pytest.raises(CaseError) as err:
-        catdae.run(catdae.load_case(text.replace("HB", "1500.0")))
+        catdae.run(catdae.load_case(text(1500.0)))
     msg = str(err.value)
     assert "cannot be reached" in msg and "together" in msg
     assert "cables[" in msg and "form.horizontal_tension" in msg
 
 
 @pytest.mark.parametrize(("form", "extra", "path", "fragment"), [
-    ("length = 100.0\nform = { sag = 2.0 }", "", "cables[0]", "either length or form"),
-    ("form = { sag = 2.0, tension = 10.0 }", "", "cables[0].form", "exactly one of"),
-    ("form = { tension = 10.0 }", "", "cables[0].form.at", "missing"),
-    ('form = { tension = 10.0, at = "Q" }', "", "cables[0].form.at", "expected an end"),
-    ('form = { sag = 2.0, at = "A" }', "", "cables[0].form.at", "tension"),
-    ("form = { sagg = 2.0 }", "", "cables[0].form.sagg", "did you mean 'sag'"),
-    ("form = { sag = -2.0 }", "", "cables[0].form.sag", "> 0"),
-    ("form = 3.0", "", "cables[0].form", "expected a table"),
-    ("form = { sag = 2.0 }", '[[loads]]\nname = "p"\ncable = "c"\ns = 3.0\n'
-     "force = [0.0, 0.0, -1.0]\n", "loads[0].s", "mesh node"),
+    ({"length": 100.0, "form": {"sag": 2.0}}, "", "cables[0]", "either length or form"),
+    ({"form": {"sag": 2.0, "tension": 10.0}}, "", "cables[0].form", "exactly one of"),
+    ({"form": {"tension": 10.0}}, "", "cables[0].form.at", "missing"),
+    ({"form": {"tension": 10.0, "at": "Q"}}, "", "cables[0].form.at", "expected an end"),
+    ({"form": {"sag": 2.0, "at": "A"}}, "", "cables[0].form.at", "tension"),
+    ({"form": {"sagg": 2.0}}, "", "cables[0].form.sagg", "did you mean 'sag'"),
+    ({"form": {"sag": -2.0}}, "", "cables[0].form.sag", "> 0"),
+    ({"form": 3.0}, "", "cables[0].form", "expected a table"),
+    ({"form": {"sag": 2.0}}, load("p", [0.0, 0.0, -1.0], cable="c", s=3.0), "loads[0].s",
+     "mesh node"),
 ])
 def test_bad_form_names_the_field(form, extra, path, fragment):
     with pytest.raises(CaseError) as err:
@@ -160,8 +154,7 @@ def test_bad_form_names_the_field(form, extra, path, fragment):
 
 
 def test_form_finding_needs_a_static_first_step():
-    text = one_cable("form = { sag = 2.0 }",
-                     steps='[[steps]]\nkind = "modal"\nmodes = 2\n')
+    text = one_cable({"form": {"sag": 2.0}}, steps=step("modal", modes=2))
     with pytest.raises(CaseError) as err:
         catdae.load_case(text)
     assert "expected a static step first" in dict(err.value.problems)["steps[0].kind"]
@@ -182,16 +175,15 @@ def test_sap2000_prestressed_cable_net_7_003():
     members = [("a1", "n1"), ("n2", "a2"), ("a3", "n3"), ("n4", "a4"), ("b1", "n1"),
                ("n3", "b3"), ("b2", "n2"), ("n4", "b4")]
     horizontal = [("n1", "n2"), ("n3", "n4"), ("n1", "n3"), ("n2", "n4")]
-    text = "[materials.s]\nEA = 2724.0\nmass = 1.0\nweight = 1e-4\n[nodes]\n"
-    text += "".join(f"{k} = [{x!r}.0, {y!r}.0, {z!r}.0]\n" for k, (x, y, z) in nodes.items())
-    text += "[supports]\n" + "".join(f'{k} = "pinned"\n' for k in nodes if k[0] in "ab")
-    for k, ((a, b), T) in enumerate([(m, 5.325) for m in members]
-                                    + [(m, 5.459) for m in horizontal]):
-        text += (f'[[cables]]\nname = "m{k}"\nends = ["{a}", "{b}"]\nmaterial = "s"\n'
-                 f"form = {{ pretension = {T!r} }}\nelements = 2\n")
-    text += "".join(f'[[loads]]\nname = "p{k}"\nnode = "n{k}"\nforce = [0.0, 0.0, -8.0]\n'
-                    for k in range(1, 5))
-    text += '[[steps]]\nkind = "static"\nname = "loaded"\n'
+    pretensions = [(m, 5.325) for m in members] + [(m, 5.459) for m in horizontal]
+    text = scene(materials={"s": {"EA": 2724.0, "mass": 1.0, "weight": 1e-4}},
+                 nodes={k: [float(v) for v in x] for k, x in nodes.items()},
+                 supports=[k for k in nodes if k[0] in "ab"],
+                 cables=[cable(f"m{k}", ends, "s", form={"pretension": T}, elements=2)
+                         for k, (ends, T) in enumerate(pretensions)],
+                 extra="".join(load(f"p{k}", [0.0, 0.0, -8.0], node=f"n{k}")
+                               for k in range(1, 5)),
+                 steps=static_step("loaded"))
     ds = catdae.run(catdae.load_case(text))["loaded"].ds
     u = ds.displacement.sel(node=["n1", "n2", "n3", "n4"]).values
     sign = np.array([[1, 1, 1], [-1, 1, 1], [1, -1, 1], [-1, -1, 1]])  # the net's symmetry

@@ -14,7 +14,7 @@ from scipy.optimize import brentq
 import catdae
 
 from reference import piecewise_catenary
-from scene_toml import cable_scene, static_step, transient_step
+from scene_toml import cable_scene, distributed_load, load, point_mass, static_step, step
 
 # a weightless taut string, 10 m span, strain 1e-3, with a heavy mass at midspan (node c.1)
 SPAN, L0, EA = 10.0, 9.99, 1.0e7
@@ -38,9 +38,8 @@ def string_scene(extra_loads: str, steps: str) -> str:
 
 
 def mass_and_load(active_mass: bool = True) -> str:
-    return (f'[[point_masses]]\nname = "M"\nnode = "c.1"\nmass = {MASS!r}\n'
-            f"active = {str(active_mass).lower()}\n"
-            f'[[loads]]\nname = "P"\nnode = "c.1"\nforce = [0.0, {P!r}, 0.0]\nactive = false\n')
+    return (point_mass("M", MASS, node="c.1", active=active_mass)
+            + load("P", [0.0, P, 0.0], node="c.1", active=False))
 
 
 # the cable's share of the midspan node's mass, per mass model: consistent 2 x (2/6) m L0/2 =
@@ -64,8 +63,8 @@ def test_suddenly_applied_load_peaks_at_twice_the_static_deflection(mass_model):
     omega = 2.0 * math.pi * string_frequency(MASS, mass_model)
     period = 2.0 * math.pi / omega
     steps = (static_step("before")
-             + transient_step("sudden", 1.2 * period, period / 1000, rtol=1e-9, atol=1e-12,
-                              extra=f'add = ["P"]\nmass_model = "{mass_model}"\n')
+             + step("transient", "sudden", duration=1.2 * period, output_interval=period / 1000,
+                    rtol=1e-9, atol=1e-12, add=["P"], mass_model=mass_model)
              + static_step("after"))
     tree = catdae.run(string_scene(mass_and_load(), steps))
     y0 = tree["before"].ds["displacement"].sel(node="c.1", axis="y").item()
@@ -91,12 +90,12 @@ def test_suddenly_applied_load_peaks_at_twice_the_static_deflection(mass_model):
 @pytest.mark.parametrize("mass_model", ["consistent", "blended"])
 def test_added_mass_lowers_the_frequency_and_a_removed_load_releases(mass_model):
     # the mass is absent at first (a light string), then added; the load comes and goes
-    mm = f'mass_model = "{mass_model}"\n'
-    steps = ('[[steps]]\nkind = "modal"\nname = "bare"\nmodes = 1\n' + mm
-             + '[[steps]]\nkind = "modal"\nname = "loaded"\nmodes = 1\nadd = ["M"]\n' + mm
-             + '[[steps]]\nkind = "static"\nname = "pushed"\nadd = ["P"]\n'
-             + transient_step("released", 1.2 / string_frequency(MASS, mass_model), 0.001,
-                              rtol=1e-9, atol=1e-12, remove=["P"], extra=mm))
+    steps = (step("modal", "bare", modes=1, mass_model=mass_model)
+             + step("modal", "loaded", modes=1, add=["M"], mass_model=mass_model)
+             + step("static", "pushed", add=["P"])
+             + step("transient", "released", remove=["P"],
+                    duration=1.2 / string_frequency(MASS, mass_model), output_interval=0.001,
+                    rtol=1e-9, atol=1e-12, mass_model=mass_model))
     tree = catdae.run(string_scene(mass_and_load(active_mass=False), steps))
     assert tree["bare"].ds["frequency"].values[0] == pytest.approx(
         string_frequency(0.0, mass_model), rel=1e-6)
@@ -118,21 +117,22 @@ SAG_SPAN, SAG_L0, SAG_EA, W = 100.0, 102.0, 1.0e8, 10.0  # m, m, N, N/m
 FROM, TO, Q = 13.7, 61.2, 40.0  # m, m, N/m downwards
 
 
-def sagging_scene(elements, gauss_points, load_line):
+def sagging_scene(elements, gauss_points, per_metre, **coverage):
+    """The sagging cable under the distributed load "snow" of ``per_metre`` N/m over ``coverage``
+    (from_s, to_s; the whole cable when not given)."""
     return cable_scene(B=(SAG_SPAN, 0.0, 0.0), L0=SAG_L0, EA=SAG_EA, mass=W / 9.81, weight=W,
                        elements=elements, gauss_points=gauss_points,
-                       extra='[[distributed_loads]]\nname = "snow"\ncable = "c"\n' + load_line,
+                       extra=distributed_load("c", per_metre, name="snow", **coverage),
                        steps=static_step())
 
 
 def test_partial_distributed_load_against_the_piecewise_catenary():
     ref = piecewise_catenary(SAG_SPAN, 0.0, SAG_EA,
                              [(FROM, W), (TO - FROM, W + Q), (SAG_L0 - TO, W)])
-    load = f"load = [0.0, 0.0, {-Q!r}]\nfrom_s = {FROM!r}\nto_s = {TO!r}\n"
     errs = []
     ns = np.array([4, 8, 16, 32])
     for n in ns:
-        ds = catdae.run(sagging_scene(int(n), 3, load))["st"].ds
+        ds = catdae.run(sagging_scene(int(n), 3, [0.0, 0.0, -Q], from_s=FROM, to_s=TO))["st"].ds
         rz = ds["reaction"].sel(axis="z")
         # equilibrium: the supports carry the weight and the load (to the Newton tolerance)
         total = rz.sel(node="A").item() + rz.sel(node="B").item()
@@ -163,16 +163,15 @@ def test_partial_coverage_is_as_accurate_as_a_whole_cable_load():
     n, end = 16, 50.0
     ref_all = piecewise_catenary(SAG_SPAN, 0.0, SAG_EA, [(SAG_L0, W + Q)])
     ref_part = piecewise_catenary(SAG_SPAN, 0.0, SAG_EA, [(end, W + Q), (SAG_L0 - end, W)])
-    ds_all = catdae.run(sagging_scene(n, 3, f"load = [0.0, 0.0, {-Q!r}]\n"))["st"].ds
-    ds_part = catdae.run(sagging_scene(n, 3, f"load = [0.0, 0.0, {-Q!r}]\nto_s = {end!r}\n"))
+    ds_all = catdae.run(sagging_scene(n, 3, [0.0, 0.0, -Q]))["st"].ds
+    ds_part = catdae.run(sagging_scene(n, 3, [0.0, 0.0, -Q], to_s=end))
     e_all = abs(ds_all["horizontal_tension"].item() / ref_all["H"] - 1)
     e_part = abs(ds_part["st"].ds["horizontal_tension"].item() / ref_part["H"] - 1)
     assert e_part < 1.5 * e_all, (e_part, e_all)
 
 
 def test_partial_horizontal_load_reactions_balance():
-    load = f"load = [0.0, 25.0, 0.0]\nfrom_s = {FROM!r}\nto_s = {TO!r}\n"
-    ds = catdae.run(sagging_scene(8, 3, load))["st"].ds
+    ds = catdae.run(sagging_scene(8, 3, [0.0, 25.0, 0.0], from_s=FROM, to_s=TO))["st"].ds
     ry = ds["reaction"].sel(axis="y")
     assert ry.sel(node="A").item() + ry.sel(node="B").item() == pytest.approx(
         -25.0 * (TO - FROM), rel=1e-10)
@@ -181,17 +180,17 @@ def test_partial_horizontal_load_reactions_balance():
 def test_partial_distributed_load_follows_its_time_function():
     # a ramp over 2 s, read by static steps at the case's clock: t = 0 (nothing), then after a
     # 1 s transient (half); reactions balance weight + the ramped load
-    load = (f"load = [0.0, 0.0, {-Q!r}]\nfrom_s = {FROM!r}\nto_s = {TO!r}\n"
-            'time = { kind = "ramp", duration = 2.0 }\n')
+    snow = distributed_load("c", [0.0, 0.0, -Q], name="snow", from_s=FROM, to_s=TO,
+                            time={"kind": "ramp", "duration": 2.0})
     text = cable_scene(B=(SAG_SPAN, 0.0, 0.0), L0=SAG_L0, EA=SAG_EA, mass=W / 9.81, weight=W,
-                       elements=4,
-                       extra='[[distributed_loads]]\nname = "snow"\ncable = "c"\n' + load,
-                       steps=static_step("t0") + transient_step(
-                           "wait", 1.0, 0.5, rtol=1e-4, atol=1e-4, extra='remove = ["snow"]\n')
-                       + '[[steps]]\nkind = "static"\nname = "t1"\nadd = ["snow"]\n')
+                       elements=4, extra=snow,
+                       steps=static_step("t0") + step("transient", "wait", duration=1.0,
+                                                      output_interval=0.5, rtol=1e-4, atol=1e-4,
+                                                      remove=["snow"])
+                       + step("static", "t1", add=["snow"]))
     tree = catdae.run(text)
-    for step, factor in (("t0", 0.0), ("t1", 0.5)):
-        rz = tree[step].ds["reaction"].sel(axis="z", node=["A", "B"]).sum().item()
+    for name, factor in (("t0", 0.0), ("t1", 0.5)):
+        rz = tree[name].ds["reaction"].sel(axis="z", node=["A", "B"]).sum().item()
         assert rz == pytest.approx(W * SAG_L0 + factor * Q * (TO - FROM), rel=1e-10)
 
 
@@ -211,17 +210,16 @@ def check(tmp_path, capsys, extra: str, steps: str) -> str:
     return err.replace(f"{case}: ", "@ ")
 
 
-LOADS = ('[[loads]]\nname = "P"\nnode = "c.2"\nforce = [0.0, 0.0, -1.0]\nactive = false\n'
-         '[[point_masses]]\nname = "M"\nnode = "c.1"\nmass = 2.0\n'
-         '[[distributed_loads]]\nname = "wind"\ncable = "c"\nload = [0.0, 5.0, 0.0]\n'
-         'active = false\n')
+LOADS = (load("P", [0.0, 0.0, -1.0], node="c.2", active=False)
+         + point_mass("M", 2.0, node="c.1")
+         + distributed_load("c", [0.0, 5.0, 0.0], name="wind", active=False))
 
 
 def test_add_and_remove_follow_what_is_present(tmp_path, capsys):
-    steps = ('[[steps]]\nkind = "static"\nname = "a"\nadd = ["P", "wnid"]\nremove = ["P"]\n'
-             '[[steps]]\nkind = "static"\nname = "b"\nadd = ["M"]\nremove = ["wind"]\n'
-             '[[steps]]\nkind = "static"\nname = "c"\nadd = ["wind"]\n'
-             '[[steps]]\nkind = "static"\nname = "d"\nadd = ["wind"]\nremove = ["nobody"]\n')
+    steps = (step("static", "a", add=["P", "wnid"], remove=["P"])
+             + step("static", "b", add=["M"], remove=["wind"])
+             + step("static", "c", add=["wind"])
+             + step("static", "d", add=["wind"], remove=["nobody"]))
     err = check(tmp_path, capsys, LOADS, steps)
     assert "@ steps[0].remove[0]: 'P' is both added and removed by this step" in err
     assert ("@ steps[0].add[1]: unknown point mass, load or distributed load 'wnid'; "
@@ -236,15 +234,12 @@ def test_add_and_remove_follow_what_is_present(tmp_path, capsys):
 
 
 def test_partial_coverage_is_checked_against_the_cable(tmp_path, capsys):
-    items = ('[[distributed_loads]]\nname = "d0"\ncable = "c"\nload = [0.0, 1.0, 0.0]\n'
-             'from_s = 60.0\nto_s = 20.0\n'
-             '[[distributed_loads]]\nname = "d1"\ncable = "c"\nload = [0.0, 1.0, 0.0]\n'
-             'to_s = 150.0\n'
-             '[[distributed_loads]]\nname = "d2"\ncable = "c"\nload = [0.0, 1.0, 0.0]\n'
-             'from_s = -1.0\n'
-             '[[distributed_loads]]\ncable = "c"\nload = [0.0, 1.0, 0.0]\nactive = false\n'
-             '[[distributed_loads]]\nname = "d4"\ncable = "c"\nload = [0.0, 1.0, 0.0]\n'
-             'from_s = 102.0\n')
+    side = [0.0, 1.0, 0.0]
+    items = (distributed_load("c", side, name="d0", from_s=60.0, to_s=20.0)
+             + distributed_load("c", side, name="d1", to_s=150.0)
+             + distributed_load("c", side, name="d2", from_s=-1.0)
+             + distributed_load("c", side, active=False)
+             + distributed_load("c", side, name="d4", from_s=102.0))
     err = check(tmp_path, capsys, items, static_step())
     assert ("@ distributed_loads[0].to_s: expected from_s < to_s (the load covers from_s <= s "
             "<= to_s), found from_s = 60 and to_s = 20") in err

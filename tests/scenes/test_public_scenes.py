@@ -29,6 +29,7 @@ from reference import (
 from scene_toml import (
     cable,
     cable_scene,
+    distributed_load,
     load,
     modal_step,
     point_mass,
@@ -43,10 +44,11 @@ G = 9.81
 
 
 def single_span(B, L0, EA, mass, elements, extra="", steps=None, gravity=None, A=(0.0, 0.0, 0.0),
-                supports=('A = "pinned"', 'B = "pinned"')):
-    """Cable c from A to B titled "scene"; ``supports`` are whole lines ("" for none)."""
+                supports=("A", "B"), properties=None):
+    """Cable c from A to B titled "scene"; ``supports`` as cable_scene takes them (pinned node
+    names or whole lines), ``properties``: further fields of the material."""
     return cable_scene(B=B, L0=L0, EA=EA, mass=mass, elements=elements, A=A, title="scene",
-                       gravity=gravity, supports=[s for s in supports if s], extra=extra,
+                       gravity=gravity, supports=supports, properties=properties, extra=extra,
                        steps=static_step() if steps is None else steps)
 
 
@@ -83,9 +85,9 @@ def test_point_load_or_mass_inside_element_matches_two_segment_catenary(ne, what
     # load or as the weight of a point mass; independent solution: two catenary segments
     L0, EA, m, s1, F = 43.0, 5.0e6, 1.5, 13.3, 2000.0
     if what == "load":
-        extra = f'[[loads]]\nname = "P"\ncable = "c"\ns = {s1}\nforce = [0.0, 0.0, {-F}]\n'
+        extra = load("P", [0.0, 0.0, -F], cable="c", s=s1)
     else:
-        extra = f'[[point_masses]]\nname = "P"\ncable = "c"\ns = {s1}\nmass = {F / G!r}\n'
+        extra = point_mass("P", F / G, cable="c", s=s1)
     ds = catdae.run(single_span((40.0, 0.0, -5.0), L0, EA, m, ne, extra))["st"].ds
     w = m * G
 
@@ -105,10 +107,10 @@ def test_point_load_or_mass_inside_element_matches_two_segment_catenary(ne, what
 def test_roller_support_pulled_horizontally_carries_exactly_the_pull():
     # B slides freely along x and is pulled by 2000 N: H = 2000 N, span from Irvine
     L0, EA, m = 10.0, 1.0e6, 2.0
-    extra = '[[loads]]\nname = "pull"\nnode = "B"\nforce = [2000.0, 0.0, 0.0]\n'
-    steps = '[[steps]]\nkind = "static"\nname = "st"\nload_steps = 3\n'
+    extra = load("pull", [2000.0, 0.0, 0.0], node="B")
+    steps = step("static", "st", load_steps=3)
     ds = catdae.run(single_span((10.0, 0.0, 0.0), L0, EA, m, 5, extra, steps,
-                                supports=('A = "pinned"', 'B = ["y", "z"]')))["st"].ds
+                                supports=("A", 'B = ["y", "z"]')))["st"].ds
     span = brentq(lambda s: irvine_catenary(s, 0.0, L0, EA, m * G)["H"] - 2000.0, 9.0, 10.05,
                   xtol=1e-14)
     np.testing.assert_allclose(ds.position.sel(node="B").values, [span, 0.0, 0.0], atol=1e-9)
@@ -120,10 +122,10 @@ def test_roller_support_pulled_horizontally_carries_exactly_the_pull():
 
 def test_plumb_line_with_end_mass_stretches_as_hooke_says():
     L0, EA, m, M = 10.0, 1.0e5, 2.0, 50.0
-    extra = f'[[point_masses]]\nname = "bob"\nnode = "B"\nmass = {M}\n'
-    steps = '[[steps]]\nkind = "static"\nname = "st"\nload_steps = 2\n'
+    extra = point_mass("bob", M, node="B")
+    steps = step("static", "st", load_steps=2)
     ds = catdae.run(single_span((1.0, 0.5, -9.0), L0, EA, m, 5, extra, steps,
-                                supports=('A = "pinned"', "")))["st"].ds
+                                supports=("A",)))["st"].ds
     w = m * G
     z_end = -(L0 + (w * L0**2 / 2 + M * G * L0) / EA)
     np.testing.assert_allclose(ds.position.sel(node="B").values, [0.0, 0.0, z_end], atol=1e-9)
@@ -140,7 +142,7 @@ def test_uniform_side_load_converges_to_the_catenary_under_the_resultant_load():
     we = math.hypot(w, p)
     ref = irvine_catenary(span, 0.0, L0, EA, we)
     d = np.array([0.0, p, -w]) / we
-    extra = f'[[distributed_loads]]\ncable = "c"\nload = [0.0, {p}, 0.0]\n'
+    extra = distributed_load("c", [0.0, p, 0.0])
     errs = []
     for ne in (8, 16):
         ds = catdae.run(single_span((span, 0.0, 0.0), L0, EA, m, ne, extra))["st"].ds
@@ -178,12 +180,12 @@ def test_symmetric_four_cable_net_is_symmetric_and_each_cable_is_a_catenary():
 
 
 def test_static_time_functions_are_evaluated_at_t0():
-    for tf, factor in (('{ kind = "sine", amplitude = 2.0, frequency = 1.0, phase = '
-                        f'{math.pi / 2!r} }}', 2.0),
-                       ('{ kind = "cosine", amplitude = 2.0, frequency = 1.0, offset = 0.5 }', 2.5),
-                       ('{ kind = "ramp", duration = 1.0, start = -0.5 }', 0.5),
-                       ('{ kind = "table", t = [1.0, 2.0], value = [4.0, 2.0] }', 4.0)):
-        extra = f'[[loads]]\nname = "p"\nnode = "c.2"\nforce = [0, 0, -100.0]\ntime = {tf}\n'
+    for tf, factor in (({"kind": "sine", "amplitude": 2.0, "frequency": 1.0,
+                         "phase": math.pi / 2}, 2.0),
+                       ({"kind": "cosine", "amplitude": 2.0, "frequency": 1.0, "offset": 0.5}, 2.5),
+                       ({"kind": "ramp", "duration": 1.0, "start": -0.5}, 0.5),
+                       ({"kind": "table", "t": [1.0, 2.0], "value": [4.0, 2.0]}, 4.0)):
+        extra = load("p", [0, 0, -100.0], node="c.2", time=tf)
         ds = catdae.run(single_span((10.0, 0.0, 0.0), 10.2, 1.0e6, 2.0, 4, extra))["st"].ds
         np.testing.assert_allclose(ds.reaction.sel(axis="z").sum().item(),
                                    2.0 * G * 10.2 + 100.0 * factor, rtol=1e-10)
@@ -200,8 +202,7 @@ def test_weightless_taut_cable_frequencies_are_the_taut_string_ones(direction):
     exact = taut_string_frequencies(l, T, m * L0 / l, n=4)
     got = {}
     for mm in ("consistent", "lumped"):
-        steps = (f'[[steps]]\nkind = "static"\nname = "st"\n[[steps]]\nkind = "modal"\n'
-                 f'name = "md"\nmodes = 8\nmass_model = "{mm}"\n')
+        steps = static_step() + modal_step(8, "md", mass_model=mm)
         t = catdae.run(single_span(tuple(l * e), L0, EA, m, 40, steps=steps, gravity=0.0))
         f = t["md"].ds.frequency.values
         np.testing.assert_allclose(t["st"].ds.tension.values, T, rtol=1e-10)
@@ -218,8 +219,8 @@ def test_weightless_taut_cable_frequencies_are_the_taut_string_ones(direction):
 # transients
 # --------------------------------------------------------------------------------------------------
 def test_release_of_a_load_conserves_energy_and_consecutive_steps_join():
-    extra = ('[[loads]]\nname = "P"\ncable = "c"\ns = 3.1\nforce = [0.0, 300.0, -200.0]\n'
-             '[[point_masses]]\nname = "pm"\nnode = "c.3"\nmass = 5.0\n')
+    extra = (load("P", [0.0, 300.0, -200.0], cable="c", s=3.1)
+             + point_mass("pm", 5.0, node="c.3"))
     steps = (static_step() + transient_step("a", 0.25, 0.01, rtol=1e-7, atol=1e-9, remove=["P"])
              + transient_step("b", 0.15, 0.01, rtol=1e-7, atol=1e-9))
     t = catdae.run(single_span((10.0, 2.0, 1.0), 10.3, 1.0e6, 2.0, 6, extra, steps))
@@ -234,29 +235,31 @@ def test_release_of_a_load_conserves_energy_and_consecutive_steps_join():
     np.testing.assert_allclose(a.velocity.isel(time=-1).values, b.velocity.isel(time=0).values)
 
 
-SUPPORT_MOTION_NET = scene(
-    head={"title": "support motions on three supports"},
-    materials={"m": {"EA": 1.0e6, "mass": 2.0}},
-    nodes={"A": (0.0, 0.0, 0.0), "B": (10.0, 0.0, 1.0), "C": (5.0, 8.0, 0.5),
-           "M": (5.0, 0.0, -0.3)},
-    supports=("A", "B", "C"),
-    cables=[cable("am", "AM", "m", 5.1, 2), cable("mb", "MB", "m", 5.1, 2),
-            cable("cm", "CM", "m", 8.2, 2)],
-    extra=(support_motion("A", x={"kind": "cosine", "amplitude": -0.02, "frequency": 2.0,
-                                  "offset": 0.02},
-                          z={"kind": "cosine", "amplitude": -0.03, "frequency": 1.0,
-                             "offset": 0.03})
-           + support_motion("B", z={"kind": "ramp", "duration": 0.3, "amplitude": 0.04,
-                                    "smooth": True, "start": 0.1})
-           + support_motion("C", x={"kind": "table", "t": [0.0, 0.3, 0.6],
-                                    "value": [0.0, -0.05, -0.02]})),
-    steps=static_step() + transient_step("tr", 0.3, 0.002, rtol=1e-8, atol=1e-10,
-                                         extra='mass_model = "MASS_MODEL"'))
+def support_motion_net(mass_model: str) -> str:
+    """Three supports, each moving its own way, and a free node M joined to them."""
+    return scene(
+        head={"title": "support motions on three supports"},
+        materials={"m": {"EA": 1.0e6, "mass": 2.0}},
+        nodes={"A": (0.0, 0.0, 0.0), "B": (10.0, 0.0, 1.0), "C": (5.0, 8.0, 0.5),
+               "M": (5.0, 0.0, -0.3)},
+        supports=("A", "B", "C"),
+        cables=[cable("am", "AM", "m", 5.1, 2), cable("mb", "MB", "m", 5.1, 2),
+                cable("cm", "CM", "m", 8.2, 2)],
+        extra=(support_motion("A", x={"kind": "cosine", "amplitude": -0.02, "frequency": 2.0,
+                                      "offset": 0.02},
+                              z={"kind": "cosine", "amplitude": -0.03, "frequency": 1.0,
+                                 "offset": 0.03})
+               + support_motion("B", z={"kind": "ramp", "duration": 0.3, "amplitude": 0.04,
+                                        "smooth": True, "start": 0.1})
+               + support_motion("C", x={"kind": "table", "t": [0.0, 0.3, 0.6],
+                                        "value": [0.0, -0.05, -0.02]})),
+        steps=static_step() + step("transient", "tr", duration=0.3, output_interval=0.002,
+                                   rtol=1e-8, atol=1e-10, mass_model=mass_model))
 
 
 @pytest.mark.parametrize("mass_model", ["consistent", "lumped"])
 def test_support_motion_is_followed_exactly_and_its_work_is_the_energy_gain(mass_model):
-    ds = catdae.run(SUPPORT_MOTION_NET.replace("MASS_MODEL", mass_model))["tr"].ds
+    ds = catdae.run(support_motion_net(mass_model))["tr"].ds
     t = ds.time.values
     w1, w2 = 4.0 * np.pi, 2.0 * np.pi
     disp = ds.displacement
@@ -297,17 +300,17 @@ def test_support_motion_is_followed_exactly_and_its_work_is_the_energy_gain(mass
 
 def test_mass_proportional_rayleigh_damping_decays_at_alpha_over_two():
     # C = alpha M damps every mode at exp(-alpha t / 2); equal to material damping c = alpha m
-    extra = '[[loads]]\nname = "P"\nnode = "c.4"\nforce = [0.0, 5.0, 0.0]\n'
-    steps = static_step() + transient_step("tr", 0.8, 0.002, rtol=1e-8, atol=1e-11, remove=["P"],
-                                           extra="DAMPING")
+    extra = load("P", [0.0, 5.0, 0.0], node="c.4")
     ys = {}
-    rayleigh = 'damping = { kind = "rayleigh", alpha = 0.8, beta = 0.0 }'
-    for key, d in (("none", ""), ("rayleigh", rayleigh),
-                   ("material", 'damping = { kind = "material" }')):
-        case = single_span((10.05, 0.0, 0.0), 10.0, 1.0e6, 2.0, 8, extra,
-                           steps.replace("DAMPING", d), gravity=0.0)
-        if key == "material":
-            case = case.replace("mass = 2.0", "mass = 2.0\ndamping = 1.6")
+    for key, damping, material in (
+            ("none", None, None),
+            ("rayleigh", {"kind": "rayleigh", "alpha": 0.8, "beta": 0.0}, None),
+            ("material", {"kind": "material"}, {"damping": 1.6})):
+        steps = static_step() + step("transient", "tr", remove=["P"], duration=0.8,
+                                     output_interval=0.002, rtol=1e-8, atol=1e-11,
+                                     damping=damping)
+        case = single_span((10.05, 0.0, 0.0), 10.0, 1.0e6, 2.0, 8, extra, steps, gravity=0.0,
+                           properties=material)
         ds = catdae.run(case)["tr"].ds
         ys[key] = ds.displacement.sel(node="c.4", axis="y").values
         t = ds.time.values

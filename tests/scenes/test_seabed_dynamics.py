@@ -20,40 +20,23 @@ from catdae.solvers.static import solve_static
 
 from reference import grounded_catenary
 from repo_paths import CASES
+from scene_toml import cable_scene, distributed_load, section, static_step, step
 
 G = 9.81
 
 
-def _line(seabed: str, steps: str, *, elements=8, extra_material="") -> str:
-    """A 60 m chain from an anchor on the seabed (z = -20) to a point 40 m away, 10 m up."""
-    return f"""
-gravity = {G}
-[materials.chain]
-EA = 5.0e8
-mass = 80.0
-diameter = 0.1
-{extra_material}
-[nodes]
-A = [0.0, 0.0, -20.0]
-B = [40.0, 5.0, -10.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "chain"
-length = 60.0
-elements = {elements}
-[seabed]
-z = -20.0
-{seabed}
-{steps}"""
+def _line(seabed: dict, steps: str, *, B=(40.0, 5.0, -10.0), elements=8, mass=80.0,
+          diameter=0.1, extra: str = "") -> str:
+    """A 60 m chain from an anchor on the seabed (z = -20, ``seabed``: the further fields of
+    ``[seabed]``) to B (by default 40 m away, 10 m up)."""
+    return cable_scene(A=(0.0, 0.0, -20.0), B=B, L0=60.0, EA=5.0e8, mass=mass, elements=elements,
+                       gravity=G, material="chain", properties={"diameter": diameter},
+                       extra=section("seabed", z=-20.0, **seabed) + extra, steps=steps)
 
 
-def _problem(seabed: str):
-    text = _line(seabed, '[[steps]]\nkind = "static"\n[[steps]]\nkind = "transient"\n'
-                 'duration = 1.0\noutput_interval = 0.1\nmass_model = "lumped"\n')
+def _problem(seabed: dict):
+    text = _line(seabed, step("static") + step("transient", duration=1.0, output_interval=0.1,
+                                               mass_model="lumped"))
     case = load_case(text)
     mesh = build_mesh(case)
     model = Model(case, mesh, set(), mass_model="lumped", kind="transient")
@@ -65,8 +48,8 @@ def test_seabed_iteration_matrix_against_finite_differences():
     """The contact's part of ∂r/∂y + c_j ∂r/∂y' equals central differences of its part of
     the residual (with isotropic friction, whose direction along the line does not enter),
     on a moving line with nodes below and above the seabed."""
-    model, prob, sol = _problem("stiffness = 2.0e5\ndamping = 3.0e3\nfriction = 0.6\n"
-                                "friction_velocity = 0.05")
+    model, prob, sol = _problem({"stiffness": 2.0e5, "damping": 3.0e3, "friction": 0.6,
+                                 "friction_velocity": 0.05})
     rng = np.random.default_rng(5)
     n = prob.n
     y = np.empty(2 * n)
@@ -113,15 +96,13 @@ def test_seabed_iteration_matrix_against_finite_differences():
     np.testing.assert_allclose(J, fd, rtol=0, atol=1e-6 * scale)
 
 
-def _drop(seabed: str, rtol=1e-7):
+def _drop(seabed: dict, rtol=1e-7):
     """The line held 0.2 m higher by an upward load in the static step, then released onto
     the seabed (the load removed): energies at the outputs."""
-    text = _line(seabed, '[[distributed_loads]]\nname = "lift"\ncable = "c"\n'
-                 'load = [0.0, 0.0, 400.0]\n'
-                 '[[steps]]\nkind = "static"\nname = "st"\n'
-                 '[[steps]]\nkind = "transient"\nname = "fall"\nduration = 4.0\n'
-                 f'output_interval = 0.05\nrtol = {rtol}\natol = {rtol}\n'
-                 'mass_model = "lumped"\nremove = ["lift"]\n')
+    fall = step("transient", "fall", duration=4.0, output_interval=0.05, rtol=rtol, atol=rtol,
+                mass_model="lumped", remove=["lift"])
+    text = _line(seabed, static_step("st") + fall,
+                 extra=distributed_load("c", [0.0, 0.0, 400.0], name="lift"))
     tree = catdae.run(load_case(text), progress=False)
     return tree["fall"].to_dataset()
 
@@ -130,14 +111,14 @@ def test_undamped_frictionless_contact_conserves_energy():
     """Without damping and friction the seabed is a conservative spring: the total energy
     (kinetic + strain + gravity + contact springs) of a line falling onto it and bouncing
     stays within 1e-3 of the largest kinetic energy; with damping and friction it falls."""
-    ds = _drop("stiffness = 2.0e5")
+    ds = _drop({"stiffness": 2.0e5})
     z = ds.position.sel(axis="z").values
     assert z.min() < -20.0  # the line reaches into the seabed
     e = ds.energy_total.values
     ek = ds.energy_kinetic.values.max()
     assert ek > 0
     assert np.abs(e - e[0]).max() <= 1e-3 * ek
-    lossy = _drop("stiffness = 2.0e5\ndamping = 5.0e3\nfriction = 0.5", rtol=1e-6)
+    lossy = _drop({"stiffness": 2.0e5, "damping": 5.0e3, "friction": 0.5}, rtol=1e-6)
     el = lossy.energy_total.values
     assert el[-1] < el[0] - 0.1 * ek
     assert np.all(np.diff(el) <= 1e-3 * ek)
@@ -153,34 +134,8 @@ def test_modal_on_contact_springs_stiffens_the_vertical_modes():
     (per contact area) has its lowest vertical frequency at the spring-mass value
     sqrt(k d / m) / 2π (uniform vertical motion of the lying part, lumped mass)."""
     k, d, m = 2.0e5, 0.1, 80.0
-    text = f"""
-gravity = {G}
-[materials.chain]
-EA = 5.0e8
-mass = {m}
-diameter = {d}
-[nodes]
-A = [0.0, 0.0, -20.0]
-B = [59.0, 0.0, -20.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "chain"
-length = 60.0
-elements = 30
-[seabed]
-z = -20.0
-stiffness = {k}
-[[steps]]
-kind = "static"
-[[steps]]
-kind = "modal"
-modes = 40
-mass_model = "lumped"
-"""
+    text = _line({"stiffness": k}, step("static") + step("modal", modes=40, mass_model="lumped"),
+                 B=(59.0, 0.0, -20.0), elements=30, mass=m, diameter=d)
     tree = catdae.run(load_case(text), progress=False)
     f = tree[list(tree.children)[1]].to_dataset().frequency.values
     f0 = math.sqrt(k * d / m) / (2 * math.pi)

@@ -18,6 +18,7 @@ import catdae
 from catdae.case import load_case
 
 from reference import grounded_catenary
+from scene_toml import cable, load, scene, section
 
 EA = 1.674e9
 MASS = 390.0
@@ -29,30 +30,17 @@ CHAINS = {200: (700.0, 760.0), 600: (1500.0, 1700.0)}  # depth: (anchor x, lengt
 
 
 def chain_toml(depth: int, elements: int, *, reverse: bool = False, fairlead=(0.0, 0.0, 0.0),
-               steps: str = "") -> str:
+               steps: str = "", free_fairlead: bool = False, extra: str = "") -> str:
+    """The studless chain from its anchor on the seabed at ``depth`` to the fairlead (pinned
+    unless ``free_fairlead``); ``reverse``: the cable runs from the fairlead to the anchor."""
     x, length = CHAINS[depth]
-    ends = '["fairlead", "anchor"]' if reverse else '["anchor", "fairlead"]'
-    return f"""
-title = "studless chain, {depth} m"
-[materials.chain]
-EA = {EA!r}
-mass = {MASS!r}
-weight = {W_SUB!r}
-[nodes]
-anchor = [{x!r}, 0.0, {-float(depth)!r}]
-fairlead = [{fairlead[0]!r}, {fairlead[1]!r}, {fairlead[2]!r}]
-[supports]
-anchor = "pinned"
-fairlead = "pinned"
-[[cables]]
-name = "chain"
-ends = {ends}
-material = "chain"
-length = {length!r}
-elements = {elements}
-[seabed]
-z = {-float(depth)!r}
-{steps}"""
+    ends = ("fairlead", "anchor") if reverse else ("anchor", "fairlead")
+    return scene(head={"title": f"studless chain, {depth} m"},
+                 materials={"chain": {"EA": EA, "mass": MASS, "weight": W_SUB}},
+                 nodes={"anchor": (x, 0.0, -float(depth)), "fairlead": fairlead},
+                 supports=("anchor",) if free_fairlead else ("anchor", "fairlead"),
+                 cables=cable("chain", ends, "chain", length, elements),
+                 extra=extra + section("seabed", z=-float(depth)), steps=steps)
 
 
 def run_static(text: str):
@@ -144,13 +132,8 @@ def test_free_fairlead_finds_the_grounded_equilibrium(elements):
     the 10-element line does not converge; docs/theory.md §17.4.)"""
     x, length = CHAINS[200]
     ref = grounded_catenary(x, 200.0, length, EA, W_SUB)
-    text = chain_toml(200, elements, fairlead=(20.0, 0.0, -30.0)).replace(
-        'fairlead = "pinned"\n', "")
-    text = text.replace("[seabed]", f"""[[loads]]
-name = "pull"
-node = "fairlead"
-force = [{-ref['H']!r}, 0.0, {ref['V']!r}]
-[seabed]""")
+    text = chain_toml(200, elements, fairlead=(20.0, 0.0, -30.0), free_fairlead=True,
+                      extra=load("pull", [-ref["H"], 0.0, ref["V"]], node="fairlead"))
     ds = run_static(text)
     fair = ds.position.sel(node="fairlead").values
     assert fair == pytest.approx([0.0, 0.0, 0.0], abs=1e-6 * x)

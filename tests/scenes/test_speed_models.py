@@ -11,7 +11,14 @@ import pytest
 import catdae
 from catdae.element.elements import Elements, PointLoads
 
-from scene_toml import cable_scene, modal_step, static_step, transient_step
+from scene_toml import (
+    cable_scene,
+    modal_step,
+    point_mass,
+    static_step,
+    step,
+    support_motion,
+)
 
 # ----------------------------------------------------------------------------------------------
 # blended mass: order 4 on the taut string
@@ -56,7 +63,7 @@ def test_blended_is_the_average_of_consistent_and_lumped():
     """M_blended = ½ M_consistent + ½ M_lumped, assembled on a sagging cable with a point mass
     inside an element; the total mass is kept."""
     text = cable_scene(B=(30.0, 0.0, 5.0), L0=33.0, EA=1e7, mass=3.0, elements=5, gravity=9.81,
-                       extra='[[point_masses]]\nname = "p"\ncable = "c"\ns = 7.3\nmass = 40.0\n',
+                       extra=point_mass("p", 40.0, cable="c", s=7.3),
                        steps=static_step())
     case = catdae.load_case(text)
     from catdae.model.assembly import Model
@@ -110,14 +117,17 @@ def test_analytic_mass_gradient_matches_complex_step():
 # ----------------------------------------------------------------------------------------------
 # transients: the blend balances work and energy; the order choice converges
 # ----------------------------------------------------------------------------------------------
-def _moving_cable(n: int, duration: float, rtol: float, extra: str = "") -> str:
-    motion = ('[[support_motions]]\nnode = "B"\n'
-              'x = { kind = "cosine", amplitude = -0.05, frequency = 0.5, offset = 0.05 }\n')
+def _moving_cable(n: int, duration: float, rtol: float, max_order: int | None = None) -> str:
+    """The 100 m cable whose end B moves 0.05 (1 - cos πt) m along the span, in the blended
+    transient "motion" (``max_order``: its BDF order limit, when given)."""
+    motion = support_motion("B", x={"kind": "cosine", "amplitude": -0.05, "frequency": 0.5,
+                                    "offset": 0.05})
     return cable_scene(B=(100.0, 0.0, 0.0), L0=102.0, EA=1e8, mass=100.0 / 9.81, weight=100.0,
                        elements=n, gauss_points=3, gravity=9.81, extra=motion,
                        steps=static_step("initial")
-                       + transient_step("motion", duration, 0.01, rtol=rtol, atol=rtol * 1e-2,
-                                        extra='mass_model = "blended"\n' + extra))
+                       + step("transient", "motion", duration=float(duration),
+                              output_interval=0.01, rtol=float(rtol), atol=rtol * 1e-2,
+                              mass_model="blended", max_order=max_order))
 
 
 def test_blended_work_energy_balance():
@@ -145,7 +155,7 @@ def test_automatic_order_switches_on_a_fine_mesh_and_agrees():
     ds = fine["motion"].ds
     assert ds.attrs["max_order_setting"] == "auto"
     assert ds.attrs["max_order"] == 2, ds.attrs["order_choice"]
-    ref = catdae.run(catdae.load_case(_moving_cable(160, 1.0, 1e-6, "max_order = 5\n")),
+    ref = catdae.run(catdae.load_case(_moving_cable(160, 1.0, 1e-6, max_order=5)),
                      progress=False)["motion"].ds
     z = ds.position.sel(node="c.80", axis="z").values
     zr = ref.position.sel(node="c.80", axis="z").values
@@ -155,8 +165,8 @@ def test_automatic_order_switches_on_a_fine_mesh_and_agrees():
     assert coarse["motion"].ds.attrs["max_order"] == 5, coarse["motion"].ds.attrs["order_choice"]
 
 
-def _steps(n: int, duration: float, rtol: float, extra: str = "") -> tuple[int, str]:
-    ds = catdae.run(catdae.load_case(_moving_cable(n, duration, rtol, extra)),
+def _steps(n: int, duration: float, rtol: float, max_order: int | None = None) -> tuple[int, str]:
+    ds = catdae.run(catdae.load_case(_moving_cable(n, duration, rtol, max_order)),
                     progress=False)["motion"].ds
     return int(ds.attrs["n_steps"]), str(ds.attrs["order_choice"])
 
@@ -165,8 +175,8 @@ def test_automatic_order_keeps_order_5_where_it_is_cheaper():
     """32 elements at rtol 1e-5 over 10 s: fixed order 5 takes well under half the steps of
     fixed order 2 (accuracy, not stability, sets its step). The race measures that and does
     not cost more than a quarter over fixed order 5 (benchmarks/speed_accuracy.md §8)."""
-    n5, _ = _steps(32, 10.0, 1e-5, "max_order = 5\n")
-    n2, _ = _steps(32, 10.0, 1e-5, "max_order = 2\n")
+    n5, _ = _steps(32, 10.0, 1e-5, max_order=5)
+    n2, _ = _steps(32, 10.0, 1e-5, max_order=2)
     auto, choice = _steps(32, 10.0, 1e-5)
     assert n5 < 0.6 * n2  # the premise: order 5 is the cheaper here
     assert choice.startswith("order 5"), choice
@@ -178,8 +188,8 @@ def test_automatic_order_goes_to_order_2_where_it_is_cheaper():
     """40 elements at rtol 1e-3 over 10 s: order 5 is held down by the axial modes' stability
     (it takes more steps than at rtol 1e-4), order 2 takes a fifth of its steps. The race must
     find order 2 and take far fewer steps than fixed order 5."""
-    n5, _ = _steps(40, 10.0, 1e-3, "max_order = 5\n")
-    n2, _ = _steps(40, 10.0, 1e-3, "max_order = 2\n")
+    n5, _ = _steps(40, 10.0, 1e-3, max_order=5)
+    n2, _ = _steps(40, 10.0, 1e-3, max_order=2)
     auto, choice = _steps(40, 10.0, 1e-3)
     assert n2 < 0.4 * n5  # the premise: order 2 is much the cheaper here
     assert choice.startswith("order 2"), choice

@@ -23,6 +23,7 @@ import pytest
 import catdae
 
 from repo_paths import CASES  # noqa: E402
+from scene_toml import static_step, support_motion, transient_step
 
 GENTLE = (CASES / "example2_support_motion_gentle.toml").read_text()
 SINE_Z = 'z = { kind = "sine", amplitude = 0.03, frequency = 0.5 }'
@@ -293,24 +294,23 @@ def test_no_note_when_the_elements_are_bars(tmp_path):
 
 
 def _ramp_case(tmp_path, name, z, steps):
-    """The gentle example 2 with support A's z given by ``z`` and the transient ``steps``."""
+    """The gentle example 2 with support A's z given by ``z`` (a time function, as a mapping)
+    and the transient ``steps``."""
     head = GENTLE.split("[[support_motions]]")[0]
-    text = (head + f'[[support_motions]]\nnode = "A"\nz = {z}\n'
-            + '[[steps]]\nkind = "static"\nname = "initial"\n' + steps)
+    text = head + support_motion("A", z=z) + static_step("initial") + steps
     path = tmp_path / f"{name}.toml"
     path.write_text(text)
     return path
 
 
 def _tr(name, duration, dt=0.05):
-    return (f'[[steps]]\nkind = "transient"\nname = "{name}"\nduration = {duration}\n'
-            f"output_interval = {dt}\nrtol = 1e-9\natol = 1e-11\n")
+    return transient_step(name, duration, dt, rtol=1e-9, atol=1e-11)
 
 
 def test_a_jump_at_the_boundary_between_two_steps(tmp_path):
     """A linear ramp that starts exactly where a step ends: two steps give one step's answer
     (the jump is applied at the end of the first step, whose last output is after it)."""
-    z = '{ kind = "ramp", start = 0.5, duration = 1.0, amplitude = 0.5 }'
+    z = {"kind": "ramp", "start": 0.5, "duration": 1.0, "amplitude": 0.5}
     one = catdae.run(_ramp_case(tmp_path, "one", z, _tr("a", 1.0)), progress=False)["a"].ds
     two = catdae.run(_ramp_case(tmp_path, "two", z, _tr("a", 0.5) + _tr("b", 0.5)),
                      progress=False)
@@ -331,12 +331,12 @@ def test_a_jump_at_the_boundary_between_two_steps(tmp_path):
 def test_ramp_corner_found_whatever_the_rounding(tmp_path, start, duration):
     """The end corner of a ramp is an impulse however start + duration rounds: moving it by
     1e-10 s changes the later response by about that, not by the whole jump."""
-    z = f'{{ kind = "ramp", start = {start}, duration = {duration}, amplitude = 0.05 }}'
+    z = {"kind": "ramp", "start": start, "duration": duration, "amplitude": 0.05}
     ds = catdae.run(_ramp_case(tmp_path, "corner", z, _tr("a", 1.5, 0.25)),
                     progress=False)["a"].ds
     assert ds.attrs["n_restarts"] == 2
-    ref = catdae.run(_ramp_case(tmp_path, "ref", '{ kind = "ramp", start = 0.3, duration = '
-                                '0.7, amplitude = 0.05 }', _tr("a", 1.5, 0.25)),
+    ref = catdae.run(_ramp_case(tmp_path, "ref", {"kind": "ramp", "start": 0.3, "duration": 0.7,
+                                                  "amplitude": 0.05}, _tr("a", 1.5, 0.25)),
                      progress=False)["a"].ds
     v, v_ref = ds.velocity.sel(time=1.25).values, ref.velocity.sel(time=1.25).values
     assert np.abs(v - v_ref).max() < 1e-6 * np.abs(v_ref).max()
@@ -345,10 +345,10 @@ def test_ramp_corner_found_whatever_the_rounding(tmp_path, start, duration):
 def test_breakpoints_within_rounding_are_one_restart(tmp_path):
     """Corners at 0.1 + 0.2 (= 0.30000000000000004) and 0.3 are one restart, not a crash."""
     head = GENTLE.split("[[support_motions]]")[0]
-    text = (head + '[[support_motions]]\nnode = "A"\n'
-            'z = { kind = "ramp", start = 0.1, duration = 0.2, amplitude = 0.02 }\n'
-            'y = { kind = "ramp", start = 0.3, duration = 0.1, amplitude = 0.01 }\n'
-            '[[steps]]\nkind = "static"\nname = "initial"\n' + _tr("a", 0.5, 0.1))
+    text = (head + support_motion(
+        "A", z={"kind": "ramp", "start": 0.1, "duration": 0.2, "amplitude": 0.02},
+        y={"kind": "ramp", "start": 0.3, "duration": 0.1, "amplitude": 0.01})
+        + static_step("initial") + _tr("a", 0.5, 0.1))
     path = tmp_path / "close.toml"
     path.write_text(text)
     ds = catdae.run(path, progress=False)["a"].ds

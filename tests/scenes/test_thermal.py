@@ -21,7 +21,7 @@ import catdae
 from catdae.errors import CaseError
 
 from reference import level_catenary_midspan
-from scene_toml import cable_scene, static_step
+from scene_toml import cable, cable_scene, distributed_load, load, point_mass, scene, step
 
 # code_aster V6.02.114 (SSNL114): 2 l0 = 2 L = 325 m, A = 2.2783e-4 m², E = 5.7e10 Pa,
 # α = 2.3e-5 /K, ρ = 2844.23 kg/m³, g = 9.81; heated from 0 to 39.26 °C
@@ -34,9 +34,8 @@ def ssnl114_text(elements=10):
     EA, m = p["E"] * p["A"], p["rho"] * p["A"]
     return cable_scene(
         B=(p["L"], 0.0, 0.0), L0=p["L"], EA=EA, mass=m, elements=elements,
-        steps=static_step("cold") + (f'[[steps]]\nkind = "static"\nname = "hot"\n'
-                                     f'temperature_change = {p["dT"]!r}\n'),
-    ).replace("[nodes]", f"thermal_expansion = {p['alpha']!r}\n[nodes]")
+        properties={"thermal_expansion": p["alpha"]},
+        steps=step("static", "cold") + step("static", "hot", temperature_change=p["dT"]))
 
 
 def test_ssnl114_heavy_cable_heated():
@@ -62,14 +61,11 @@ def plumb_text(dT, alpha, s_load, gravity=None, M=50.0, P=30.0):
     """A line from A (pinned) to B (free, started 2 m to the side so that no element starts
     vertical and slack) with a point mass M at B and a downward load P on the cable at arc
     length s_load: it hangs vertically below A."""
-    lines = cable_scene(B=(2.0, 0.0, -20.0), L0=20.0, EA=2e5, mass=1.2, elements=4,
-                        supports=("A",), gravity=gravity,
-                        extra=(f'[[point_masses]]\nname = "end"\nnode = "B"\nmass = {M!r}\n'
-                               f'[[loads]]\nname = "p"\ncable = "c"\ns = {s_load!r}\n'
-                               f"force = [0.0, 0.0, {-P!r}]\n"),
-                        steps=(f'[[steps]]\nkind = "static"\nname = "st"\n'
-                               f"temperature_change = {dT!r}\n"))
-    return lines.replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+    return cable_scene(B=(2.0, 0.0, -20.0), L0=20.0, EA=2e5, mass=1.2, elements=4,
+                       supports=("A",), gravity=gravity, properties={"thermal_expansion": alpha},
+                       extra=(point_mass("end", M, node="B")
+                              + load("p", [0.0, 0.0, -P], cable="c", s=s_load)),
+                       steps=step("static", "st", temperature_change=dT))
 
 
 def plumb_z(s, L0, EA, w, M, g, P, s_load, eps_t):
@@ -95,15 +91,13 @@ def test_plumb_line_heated_with_a_load_inside_an_element(dT):
 
 def test_weightless_taut_bar_and_per_cable_temperature():
     EA, L0, chord, alpha = 1e6, 9.9, 10.0, 1e-4
-    text = (
-        '[materials.m]\nEA = 1e6\nmass = 0.5\nweight = 0.0\nthermal_expansion = 1e-4\n'
-        '[nodes]\nA = [0.0, 0.0, 0.0]\nB = [10.0, 0.0, 0.0]\nC = [0.0, 5.0, 0.0]\n'
-        'D = [10.0, 5.0, 0.0]\n[supports]\nA = "pinned"\nB = "pinned"\nC = "pinned"\n'
-        'D = "pinned"\n'
-        '[[cables]]\nname = "hot"\nends = ["A", "B"]\nmaterial = "m"\nlength = 9.9\n'
-        '[[cables]]\nname = "cold"\nends = ["C", "D"]\nmaterial = "m"\nlength = 9.9\n'
-        '[[steps]]\nkind = "static"\nname = "st"\ntemperature_change = { hot = 50.0 }\n'
-    )
+    text = scene(
+        materials={"m": {"EA": EA, "mass": 0.5, "weight": 0.0, "thermal_expansion": alpha}},
+        nodes={"A": (0.0, 0.0, 0.0), "B": (chord, 0.0, 0.0), "C": (0.0, 5.0, 0.0),
+               "D": (chord, 5.0, 0.0)},
+        supports=("A", "B", "C", "D"),
+        cables=[cable("hot", ("A", "B"), "m", L0), cable("cold", ("C", "D"), "m", L0)],
+        steps=step("static", "st", temperature_change={"hot": 50.0}))
     ds = catdae.run(catdae.load_case(text))["st"].ds
     T = ds.cable_end_tension.sel(end="i").values
     assert T[0] == pytest.approx(EA * (chord / L0 - 1.0 - alpha * 50.0), rel=1e-10)
@@ -113,12 +107,11 @@ def test_weightless_taut_bar_and_per_cable_temperature():
 def test_temperature_holds_in_the_modal_and_transient_steps_that_follow():
     # a taut string: f_k = k/(2 l) sqrt(T l / (m L0)) with T = EA (l/L0 - 1 - α ΔT)
     l, L0, EA, m, alpha, dT = 10.0, 9.99, 1e6, 0.2, 2e-5, 25.0
-    steps = (f'[[steps]]\nkind = "static"\nname = "hot"\ntemperature_change = {dT!r}\n'
-             '[[steps]]\nkind = "modal"\nname = "modes"\nmodes = 2\n'
-             '[[steps]]\nkind = "transient"\nname = "rest"\nduration = 0.05\n'
-             'output_interval = 0.01\nrtol = 1e-8\natol = 1e-10\n')
+    steps = (step("static", "hot", temperature_change=dT) + step("modal", "modes", modes=2)
+             + step("transient", "rest", duration=0.05, output_interval=0.01, rtol=1e-8,
+                    atol=1e-10))
     text = cable_scene(B=(l, 0.0, 0.0), L0=L0, EA=EA, mass=m, weight=0.0, elements=40,
-                       steps=steps).replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+                       properties={"thermal_expansion": alpha}, steps=steps)
     tree = catdae.run(catdae.load_case(text))
     T = EA * (l / L0 - 1.0 - alpha * dT)
     f1 = 1.0 / (2.0 * l) * math.sqrt(T * l / (m * L0))
@@ -133,13 +126,13 @@ def test_temperature_holds_in_the_modal_and_transient_steps_that_follow():
 
 
 @pytest.mark.parametrize(("value", "path", "fragment"), [
-    ('"hot"', "steps[0].temperature_change", "expected a temperature change in K"),
-    ("{ nope = 3.0 }", "steps[0].temperature_change.nope", "unknown cable 'nope'"),
-    ('{ c = "warm" }', "steps[0].temperature_change.c", "finite number"),
+    ("hot", "steps[0].temperature_change", "expected a temperature change in K"),
+    ({"nope": 3.0}, "steps[0].temperature_change.nope", "unknown cable 'nope'"),
+    ({"c": "warm"}, "steps[0].temperature_change.c", "finite number"),
 ])
 def test_bad_temperature_names_the_field(value, path, fragment):
     text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=1e6, mass=1.0,
-                       steps=f'[[steps]]\nkind = "static"\ntemperature_change = {value}\n')
+                       steps=step("static", temperature_change=value))
     with pytest.raises(CaseError) as err:
         catdae.load_case(text)
     found = dict(err.value.problems)
@@ -147,8 +140,8 @@ def test_bad_temperature_names_the_field(value, path, fragment):
 
 
 def test_bad_thermal_expansion_names_the_field():
-    text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=1e6, mass=1.0).replace(
-        "[nodes]", 'thermal_expansion = "steel"\n[nodes]')
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=1e6, mass=1.0,
+                       properties={"thermal_expansion": "steel"})
     with pytest.raises(CaseError) as err:
         catdae.load_case(text)
     assert "expected a number" in dict(err.value.problems)["materials.m.thermal_expansion"]
@@ -159,16 +152,12 @@ def test_opensees_two_cable_example_with_a_thermal_load():
     # 50 m cables from (0, 0, 90) to node 2 at (15, 0, 40) (free in x and z) to (30, 60, 30),
     # E A = 3e7 N, a uniform load of 1 N per unstrained metre along -z, α = 6.5e-6 /K,
     # ΔT = 100 K. Published: node 2 moves by (8.58693, 0, 2.82578) m.
-    text = (
-        "[materials.s]\nEA = 3.0e7\nmass = 0.1\nweight = 1.0\nthermal_expansion = 6.5e-6\n"
-        "[nodes]\nN1 = [0.0, 0.0, 90.0]\nN2 = [15.0, 0.0, 40.0]\nN3 = [30.0, 60.0, 30.0]\n"
-        '[supports]\nN1 = "pinned"\nN2 = ["y"]\nN3 = "pinned"\n'
-        '[[cables]]\nname = "a"\nends = ["N1", "N2"]\nmaterial = "s"\nlength = 50.0\n'
-        "elements = 4\n"
-        '[[cables]]\nname = "b"\nends = ["N2", "N3"]\nmaterial = "s"\nlength = 50.0\n'
-        "elements = 4\n"
-        '[[steps]]\nkind = "static"\nname = "hot"\ntemperature_change = 100.0\n'
-    )
+    text = scene(
+        materials={"s": {"EA": 3.0e7, "mass": 0.1, "weight": 1.0, "thermal_expansion": 6.5e-6}},
+        nodes={"N1": (0.0, 0.0, 90.0), "N2": (15.0, 0.0, 40.0), "N3": (30.0, 60.0, 30.0)},
+        supports=("N1", 'N2 = ["y"]', "N3"),
+        cables=[cable("a", ("N1", "N2"), "s", 50.0, 4), cable("b", ("N2", "N3"), "s", 50.0, 4)],
+        steps=step("static", "hot", temperature_change=100.0))
     ds = catdae.run(catdae.load_case(text))["hot"].ds
     assert ds.displacement.sel(node="N2").values == pytest.approx([8.58693, 0.0, 2.82578],
                                                                   abs=5e-6)
@@ -179,11 +168,9 @@ def test_distributed_load_is_per_unstrained_metre_at_the_reference_temperature()
     # the supports take w L0 + q L0 along z and p L0 along y
     L0, w, q, p, alpha, dT = 10.5, 1.2 * 9.81, 3.0, 2.0, 1e-3, 50.0
     text = cable_scene(B=(10.0, 0.0, 0.0), L0=L0, EA=1e5, mass=1.2, elements=5,
-                       extra=('[[distributed_loads]]\ncable = "c"\n'
-                              f"load = [0.0, {p!r}, {-q!r}]\n"),
-                       steps=(f'[[steps]]\nkind = "static"\nname = "st"\n'
-                              f"temperature_change = {dT!r}\n"))
-    text = text.replace("[nodes]", f"thermal_expansion = {alpha!r}\n[nodes]")
+                       properties={"thermal_expansion": alpha},
+                       extra=distributed_load("c", [0.0, p, -q]),
+                       steps=step("static", "st", temperature_change=dT))
     ds = catdae.run(catdae.load_case(text))["st"].ds
     R = ds.reaction.sel(node=["A", "B"]).values.sum(axis=0)
     assert R == pytest.approx([0.0, -p * L0, (w + q) * L0], abs=1e-9 * (w + q) * L0)

@@ -18,37 +18,13 @@ import catdae
 from catdae.cli import main
 
 from reference import irvine_catenary
+from scene_toml import cable_scene, distributed_load, modal_step, static_step
 
 EA, MASS, G, WIND, L0 = 2.0e7, 1.6, 9.81, 9.0, 101.0
 
-CASE = f"""
-title = "wind"
-[materials.m]
-EA = {EA!r}
-mass = {MASS!r}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [100.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "span"
-ends = ["A", "B"]
-material = "m"
-length = {L0!r}
-elements = 12
-[[distributed_loads]]
-cable = "span"
-load = [0.0, {WIND!r}, 0.0]
-[[steps]]
-kind = "static"
-name = "windy"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 12
-"""
+CASE = cable_scene(title="wind", B=(100.0, 0.0, 0.0), L0=L0, EA=EA, mass=MASS, elements=12,
+                   cable="span", extra=distributed_load("span", [0.0, WIND, 0.0]),
+                   steps=static_step("windy") + modal_step(12))
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import pytest
 from catdae.case import case_from_dict
 from catdae.model.connectors import Connectors
 
-from scene_toml import cable_scene, static_step, transient_step
+from scene_toml import bar, cable_scene, damper, point_mass, spring, static_step, step
 
 
 def _toml(text):
@@ -74,34 +74,17 @@ def test_connector_blocks_are_the_derivatives_of_their_forces():
     assert np.allclose(cn.axial_force(X @ R.T, V @ R.T), cn.axial_force(X, V), rtol=1e-13)
 
 
-NETWORK = """[[springs]]
-name = "k1"
-ends = ["c.1", "G"]
-stiffness = 3.0e3
-length = 2.5
-[[dampers]]
-name = "d1"
-ends = ["c.2", "G"]
-coefficient = 400.0
-[[bars]]
-name = "hanger"
-ends = ["c.3", "H"]
-EA = 1.0e6
-mass = 3.0
-[[point_masses]]
-name = "pm"
-node = "H"
-mass = 5.0
-"""
+NETWORK = (spring("k1", ["c.1", "G"], 3.0e3, length=2.5) + damper("d1", ["c.2", "G"], 400.0)
+           + bar("hanger", ["c.3", "H"], 1.0e6, mass=3.0) + point_mass("pm", 5.0, node="H"))
 
 
 def network(mass_model: str) -> str:
     """A cable with a spring and a damper to the ground G and a bar hanging a mass H."""
-    step = transient_step("dyn", 0.1, 0.05, rtol=1e-6, atol=1e-8)
     return cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
-                       extra=NETWORK, steps=step + f'mass_model = "{mass_model}"\n').replace(
-        "[supports]\n", '[supports]\nG = "pinned"\n').replace(
-        "[nodes]\n", "[nodes]\nG = [5.0, 2.0, -1.0]\nH = [7.5, 0.5, -4.0]\n")
+                       nodes={"G": (5.0, 2.0, -1.0), "H": (7.5, 0.5, -4.0)},
+                       supports=("G", "A", "B"), extra=NETWORK,
+                       steps=step("transient", "dyn", duration=0.1, output_interval=0.05,
+                                  rtol=1e-6, atol=1e-8, mass_model=mass_model))
 
 
 @pytest.mark.parametrize("mass_model", ["lumped", "linear"])
@@ -163,23 +146,20 @@ def test_connectors_off_leave_the_model_as_it_was():
 def bad(extra: str) -> str:
     """The network's cable with a ground node G, a second ground G2 at the same place."""
     return cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
-                       extra=extra, steps=static_step("st")).replace(
-        "[supports]\n", '[supports]\nG = "pinned"\nG2 = "pinned"\n').replace(
-        "[nodes]\n", "[nodes]\nG = [5.0, 2.0, -1.0]\nG2 = [5.0, 2.0, -1.0]\n")
+                       nodes={"G": (5.0, 2.0, -1.0), "G2": (5.0, 2.0, -1.0)},
+                       supports=("G", "G2", "A", "B"), extra=extra, steps=static_step("st"))
 
 
 @pytest.mark.parametrize(("extra", "field", "words"), [
-    ('[[springs]]\nname = "k"\nends = ["c.2", "nowhere"]\nstiffness = 1.0\n',
-     "springs[0].ends[1]", "unknown node 'nowhere'"),
-    ('[[springs]]\nname = "k"\nends = ["c.2", "c.9"]\nstiffness = 1.0\n',
-     "springs[0].ends[1]", "mesh node 'c.9' does not exist"),
-    ('[[dampers]]\nname = "d"\nends = ["c.2", "G"]\ncoefficient = -5.0\n',
+    (spring("k", ["c.2", "nowhere"], 1.0), "springs[0].ends[1]", "unknown node 'nowhere'"),
+    (spring("k", ["c.2", "c.9"], 1.0), "springs[0].ends[1]", "mesh node 'c.9' does not exist"),
+    (damper("d", ["c.2", "G"], -5.0),
      "dampers[0].coefficient", "expected a value >= 0.0, found the number -5.0"),
-    ('[[bars]]\nname = "b"\nends = ["c.2", "G"]\nEA = 1.0e6\nlength = 0.0\n',
+    (bar("b", ["c.2", "G"], 1.0e6, length=0.0),
      "bars[0].length", "expected a value > 0.0, found the number 0.0"),
-    ('[[bars]]\nname = "b"\nends = ["G", "G2"]\nEA = 1.0e6\n',
+    (bar("b", ["G", "G2"], 1.0e6),
      "bars[0].ends", "a bar of zero length: nodes 'G' and 'G2' coincide"),
-    ('[[dampers]]\nname = "d"\nends = ["c.1", "c.1"]\ncoefficient = 5.0\n',
+    (damper("d", ["c.1", "c.1"], 5.0),
      "dampers[0].ends", "the two ends are the same node 'c.1'"),
 ])
 def test_bad_connectors_get_a_located_message_and_exit_2(extra, field, words, tmp_path, capsys):

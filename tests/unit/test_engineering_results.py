@@ -11,52 +11,30 @@ import catdae
 from catdae.cli import main
 from catdae.errors import CaseError
 
-BASE = """
-{top}
-[materials.m]
-EA = 1.0e6
-mass = 1.0
-{material}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 10.5
-elements = 6
-[[loads]]
-name = "kick"
-node = "c.3"
-force = [0.0, 40.0, -30.0]
-time = {{ kind = "ramp", duration = 0.05 }}
-{steps}
-"""
-
-TRANSIENT = """
-[[steps]]
-kind = "static"
-name = "rest"
-[[steps]]
-kind = "transient"
-name = "kicked"
-duration = 0.6
-output_interval = 0.01
-"""
+from scene_toml import cable_scene, load, static_step, step
 
 
-def case(top="", material="", steps=TRANSIENT):
-    return BASE.format(top=top, material=material, steps=steps)
+def transient(rest="rest", **more):
+    """The static step ``rest``, then the transient "kicked" (``more``: further keys of it)."""
+    return static_step(rest) + step("transient", "kicked", duration=0.6, output_interval=0.01,
+                                    **more)
+
+
+def case(top=None, material=None, steps=None):
+    """A 10 m span (10.5 m of cable, 6 elements) kicked at c.3 by a ramped load; ``top``: further
+    top-level keys, ``material``: further fields of the material, ``steps``: by default
+    ``transient()``."""
+    return cable_scene(B=(10.0, 0.0, 0.0), L0=10.5, EA=1.0e6, mass=1.0, elements=6, head=top,
+                       properties=material,
+                       extra=load("kick", [0.0, 40.0, -30.0], node="c.3",
+                                  time={"kind": "ramp", "duration": 0.05}),
+                       steps=transient() if steps is None else steps)
 
 
 @pytest.fixture(scope="module")
 def kicked():
-    return catdae.run(catdae.load_case(case(material="rated_strength = 2000.0",
-                                            steps=TRANSIENT + 'jump_reference = "rest"\n')),
+    return catdae.run(catdae.load_case(case(material={"rated_strength": 2000.0},
+                                            steps=transient(jump_reference="rest"))),
                       progress=False)
 
 
@@ -93,31 +71,29 @@ def test_tension_against_the_rated_strength_and_the_jump(kicked):
 
 
 def test_without_rated_strength_no_percentage():
-    tree = catdae.run(catdae.load_case(case(steps='[[steps]]\nkind = "static"\nname = "s"\n')))
+    tree = catdae.run(catdae.load_case(case(steps=static_step("s"))))
     assert "tension_percent_rated" not in tree["s"].ds
 
 
 def test_temperature_is_measured_from_the_reference_temperature():
-    c = catdae.load_case(case(top="reference_temperature = 15.0", steps=(
-        '[[steps]]\nkind = "static"\nname = "hot"\ntemperature = 55.0\n'
-        '[[steps]]\nkind = "static"\nname = "per_cable"\ntemperature = { c = -5.0 }\n')))
+    c = catdae.load_case(case(top={"reference_temperature": 15.0}, steps=(
+        step("static", "hot", temperature=55.0)
+        + step("static", "per_cable", temperature={"c": -5.0}))))
     assert c.steps[0].temperature_change == 40.0
     assert dict(c.steps[1].temperature_change) == {"c": -20.0}
     assert c.reference_temperature == 15.0
 
 
 @pytest.mark.parametrize(("top", "steps", "where", "words"), [
-    ("", '[[steps]]\nkind = "static"\ntemperature = 30.0\n', "steps[0].temperature",
+    (None, step("static", temperature=30.0), "steps[0].temperature",
      "needs the case's reference_temperature"),
-    ("reference_temperature = 15.0",
-     '[[steps]]\nkind = "static"\ntemperature = 30.0\ntemperature_change = 3.0\n',
+    ({"reference_temperature": 15.0}, step("static", temperature=30.0, temperature_change=3.0),
      "steps[0].temperature", "not both"),
-    ("reference_temperature = 15.0", '[[steps]]\nkind = "static"\ntemperature = "hot"\n',
+    ({"reference_temperature": 15.0}, step("static", temperature="hot"),
      "steps[0].temperature", "expected a temperature (the units"),
-    ("", TRANSIENT + 'jump_reference = "rst"\n', "steps[1].jump_reference",
-     "did you mean 'rest'"),
-    ("", '[[steps]]\nkind = "modal"\nname = "m"\n' + TRANSIENT.replace("rest", "r") +
-     'jump_reference = "m"\n', "steps[2].jump_reference", "static step"),
+    (None, transient(jump_reference="rst"), "steps[1].jump_reference", "did you mean 'rest'"),
+    (None, step("modal", "m") + transient("r", jump_reference="m"), "steps[2].jump_reference",
+     "static step"),
 ])
 def test_bad_fields_are_named(top, steps, where, words, tmp_path, capsys):
     path = tmp_path / "bad.toml"
@@ -131,8 +107,7 @@ def test_bad_fields_are_named(top, steps, where, words, tmp_path, capsys):
 
 def test_rated_strength_must_be_positive(tmp_path, capsys):
     path = tmp_path / "bad.toml"
-    path.write_text(case(material="rated_strength = -3.0",
-                         steps='[[steps]]\nkind = "static"\n'))
+    path.write_text(case(material={"rated_strength": -3.0}, steps=step("static")))
     assert main(["check", str(path)]) == 2
     assert "materials.m.rated_strength" in capsys.readouterr().err
 

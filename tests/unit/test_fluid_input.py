@@ -33,6 +33,16 @@ WATER = "[water]\ndepth = 100.0\n"
     (BASE + WATER + 'waves = { kind = "jonswap", hs = 2.0 }\n', "water.waves.tp", "missing"),
     (BASE + '[air]\nwind = { speed = 10.0, profile = "power" }\n', "air.wind.exponent",
      "missing"),
+    (cable_scene(A=(0.0, 0.0, -50.0), B=(60.0, 0.0, -10.0), L0=70.0, EA=1e8, mass=50.0,
+                 elements=4, gravity=0.0, steps=static_step()) + WATER
+     + 'waves = { kind = "airy", height = 1.0, period = 5.0 }\n', "water.waves",
+     "waves need gravity > 0"),
+    (BASE + "[water]\nsurface = -60.0\n[seabed]\nz = -55.0\n", "seabed.z",
+     "lies above the still-water level"),
+    (BASE + '[water]\ndepth = 40.0\nwaves = { kind = "airy", height = 1.0, period = 5.0 }\n',
+     "water.depth", "support 'A' (z = -50 m) lies below the water's floor"),
+    (BASE + WATER + 'waves = { kind = "airy", height = 1.0, period = 5.0 }\n[seabed]\n'
+     "z = -120.0\n", "seabed.z", "lies below the water's floor surface - depth = -100 m"),
 ])
 def test_bad_fluid_input_is_located_with_exit_2(text, field, expected, tmp_path):
     f = tmp_path / "case.toml"

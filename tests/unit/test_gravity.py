@@ -14,27 +14,33 @@ import pytest
 import catdae
 from catdae.errors import CaseError
 
+from scene_toml import (
+    cable_scene,
+    load,
+    modal_step,
+    point_mass,
+    static_step,
+    support_motion,
+    transient_step,
+)
 
-def vec(v) -> str:
-    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
 
-
-def scene(R, gravity, supports=('A = "pinned"', 'B = "pinned"'), motion=True) -> str:
+def scene(R, gravity, supports=("A", "B"), motion=True) -> str:
+    """A 30 m span (32 m of cable, 6 elements) with a load at c.2, B shaken sideways
+    (``motion``), turned by the rotation R; ``gravity``: the case's value as it stands (a
+    number, a vector or anything a bad case gives)."""
     A, B = R @ np.zeros(3), R @ np.array([30.0, 0.0, -5.0])
     P = R @ np.array([0.0, 300.0, -100.0])
-    text = (f"gravity = {gravity}\n[materials.s]\nEA = 1.0e6\nmass = 1.5\n"
-            f"[nodes]\nA = {vec(A)}\nB = {vec(B)}\n[supports]\n" + "\n".join(supports) + "\n"
-            '[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "s"\nlength = 32.0\n'
-            f'elements = 6\n[[loads]]\nname = "p"\nnode = "c.2"\nforce = {vec(P)}\n')
+    extra = load("p", P, node="c.2")
     if motion:
         u = R @ np.array([0.0, 0.05, 0.02])
-        text += '[[support_motions]]\nnode = "B"\n' + "".join(
-            f'{a} = {{ kind = "sine", amplitude = {float(u[k])!r}, frequency = 1.0 }}\n'
-            for k, a in enumerate("xyz") if u[k] != 0.0)
-    return text + ('[[steps]]\nkind = "static"\nname = "s"\n'
-                   '[[steps]]\nkind = "modal"\nname = "m"\nmodes = 4\n'
-                   '[[steps]]\nkind = "transient"\nname = "t"\nduration = 0.2\n'
-                   'output_interval = 0.05\nrtol = 1e-8\natol = 1e-10\n')
+        extra += support_motion("B", **{
+            a: {"kind": "sine", "amplitude": float(u[k]), "frequency": 1.0}
+            for k, a in enumerate("xyz") if u[k] != 0.0})
+    return cable_scene(A=A, B=B, L0=32.0, EA=1.0e6, mass=1.5, elements=6, material="s",
+                       head={"gravity": gravity}, supports=supports, extra=extra,
+                       steps=(static_step("s") + modal_step(4, "m")
+                              + transient_step("t", 0.2, 0.05, rtol=1e-8, atol=1e-10)))
 
 
 def rotation(axis, angle):
@@ -45,7 +51,7 @@ def rotation(axis, angle):
 
 @pytest.fixture(scope="module")
 def upright():
-    return catdae.run(catdae.load_case(scene(np.eye(3), "9.81")))
+    return catdae.run(catdae.load_case(scene(np.eye(3), 9.81)))
 
 
 @pytest.mark.parametrize("R", [
@@ -54,7 +60,7 @@ def upright():
 ], ids=["oblique", "y-up"])
 def test_rotated_scene_is_the_rotated_answer(upright, R):
     g = R @ np.array([0.0, 0.0, -9.81])
-    turned = catdae.run(catdae.load_case(scene(R, vec(g))))
+    turned = catdae.run(catdae.load_case(scene(R, g)))
     # statics to round-off; the transient step to its integration accuracy (IDA's error norm
     # weighs the components of each vector, so its steps differ in a turned frame)
     for step, rel in (("s", 1e-11), ("t", 1e-6)):
@@ -78,12 +84,9 @@ def test_plumb_line_hangs_along_gravity():
     # gravity along +x: a line from A with 40 kg at its free end B hangs along +x, stretched
     # by T(s)/EA with T(s) = M g + w (L0 - s)
     L0, EA, m, M, g = 12.0, 5e4, 0.8, 40.0, 9.81
-    text = (f"gravity = [{g!r}, 0.0, 0.0]\n[materials.s]\nEA = {EA!r}\nmass = {m!r}\n"
-            "[nodes]\nA = [0.0, 0.0, 0.0]\nB = [11.0, 0.0, 3.0]\n[supports]\nA = \"pinned\"\n"
-            '[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "s"\n'
-            f"length = {L0!r}\nelements = 3\n"
-            f'[[point_masses]]\nname = "end"\nnode = "B"\nmass = {M!r}\n'
-            '[[steps]]\nkind = "static"\nname = "s"\n')
+    text = cable_scene(gravity=[g, 0.0, 0.0], B=(11.0, 0.0, 3.0), L0=L0, EA=EA, mass=m,
+                       elements=3, material="s", supports=("A",),
+                       extra=point_mass("end", M, node="B"), steps=static_step("s"))
     ds = catdae.run(catdae.load_case(text))["s"].ds
     w = m * g
     for node, s in (("c.1", 4.0), ("c.2", 8.0), ("B", 12.0)):
@@ -95,20 +98,19 @@ def test_plumb_line_hangs_along_gravity():
 
 def test_partial_supports_must_stay_coordinate_constraints():
     R = rotation([1.0, 2.0, 0.5], 0.7)
-    g = vec(R @ np.array([0.0, 0.0, -9.81]))
+    g = R @ np.array([0.0, 0.0, -9.81])
     with pytest.raises(CaseError) as err:
-        catdae.load_case(scene(R, g, supports=('A = "pinned"', 'B = ["y"]'), motion=False))
+        catdae.load_case(scene(R, g, supports=("A", 'B = ["y"]'), motion=False))
     assert "pin the node" in dict(err.value.problems)["supports.B"]
     # gravity along -y: a support fixing z (perpendicular to gravity) is fine
-    text = scene(np.eye(3), "[0.0, -9.81, 0.0]", supports=('A = "pinned"', 'B = ["x", "z"]'),
-                 motion=False)
+    text = scene(np.eye(3), [0.0, -9.81, 0.0], supports=("A", 'B = ["x", "z"]'), motion=False)
     assert catdae.load_case(text).gravity_direction == (0.0, -1.0, 0.0)
 
 
 @pytest.mark.parametrize(("value", "fragment"), [
-    ("[0.0, 9.81]", "vector [gx, gy, gz] of 3 finite numbers"),
-    ('"down"', "expected a number >= 0"),
-    ("-9.81", "expected a value >= 0"),
+    ([0.0, 9.81], "vector [gx, gy, gz] of 3 finite numbers"),
+    ("down", "expected a number >= 0"),
+    (-9.81, "expected a value >= 0"),
 ])
 def test_bad_gravity_names_the_field(value, fragment):
     with pytest.raises(CaseError) as err:

@@ -11,9 +11,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from scene_toml import cable_scene, modal_step, static_step, transient_step
+from scene_toml import cable, cable_scene, load, modal_step, point_mass, static_step, transient_step
 
-PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+PUSH = load("push", [0.0, 1.0, 0.0], node="c.1")
 
 
 def catdae(*args, cwd, timeout=300) -> subprocess.CompletedProcess:
@@ -40,8 +40,7 @@ def test_a_massless_cable_with_a_mass_on_each_free_node_is_accepted(tmp_path, ca
     from catdae.cli import main
 
     f = tmp_path / "beads.toml"
-    f.write_text(massless(elements=2, extra='[[point_masses]]\nname = "bead"\nnode = "c.1"\n'
-                                            "mass = 1.0\n"))
+    f.write_text(massless(elements=2, extra=point_mass("bead", 1.0, node="c.1")))
     assert main(["check", str(f)]) == 0
     assert "valid" in capsys.readouterr().out
 
@@ -97,8 +96,7 @@ def valid(text: str, tmp_path, name="ok.toml"):
 
 # -- 3. table files: inside the case's folder, regular, bounded; content never echoed ----------
 def table_load(file: str) -> str:
-    return ('[[loads]]\nname = "p"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
-            f'time = {{ kind = "table", file = "{file}" }}\n')
+    return timed({"kind": "table", "file": file})
 
 
 def test_a_table_file_outside_the_case_folder_is_refused_unread(tmp_path, capsys):
@@ -187,8 +185,7 @@ def test_the_elements_override_is_held_to_the_same_limits(tmp_path, capsys):
 
 
 def test_a_mesh_above_the_dof_limit_is_refused(tmp_path, capsys):
-    extra = "".join(f'[[cables]]\nname = "d{k}"\nends = ["A", "B"]\nmaterial = "m"\n'
-                    f"length = {10.5 + 0.01 * k}\nelements = 10000\n" for k in range(10))
+    extra = "".join(cable(f"d{k}", ("A", "B"), "m", 10.5 + 0.01 * k, 10000) for k in range(10))
     invalid(scene(extra, elements=10000), "cables", "the mesh would have 109991 nodes "
             "(329973 degrees of freedom, 110000 elements), above the limit of 300000",
             tmp_path, capsys)
@@ -215,10 +212,12 @@ def test_control_characters_in_names_and_title_are_refused(tmp_path, capsys):
 
 
 def test_a_mesh_node_with_a_leading_zero_is_refused(tmp_path, capsys):
-    load = '[[loads]]\nname = "p"\nnode = "c.02"\nforce = [0.0, 1.0, 0.0]\n'
-    invalid(scene(load), "loads[0].node", "mesh node 'c.02' is written with a leading zero: "
-            "its name is 'c.2'", tmp_path, capsys)
-    tree = valid(scene(load.replace("c.02", "c.2")), tmp_path)
+    def on(node):
+        return load("p", [0.0, 1.0, 0.0], node=node)
+
+    invalid(scene(on("c.02")), "loads[0].node", "mesh node 'c.02' is written with a leading "
+            "zero: its name is 'c.2'", tmp_path, capsys)
+    tree = valid(scene(on("c.2")), tmp_path)
     assert tree.attrs["status"] == "completed"
 
 
@@ -243,29 +242,29 @@ def test_a_modal_step_that_needs_a_dense_solve_too_large_is_refused(tmp_path, ca
 
 
 # -- 8. no NaN on disk: degenerate time functions ------------------------------------------------
-def timed(time: str) -> str:
-    return ('[[loads]]\nname = "p"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
-            f"time = {time}\n")
+def timed(time: dict) -> str:
+    """The load "p" at c.1 along y, following the time function ``time``."""
+    return load("p", [0.0, 1.0, 0.0], node="c.1", time=time)
 
 
 DYN = static_step("st") + transient_step("dyn", 0.2, 0.05, rtol=1e-6, atol=1e-8)
 
 
 def test_a_degenerate_ramp_is_refused(tmp_path, capsys):
-    invalid(scene(timed('{ kind = "ramp", duration = 1e-200, smooth = true }'), steps=DYN),
+    invalid(scene(timed({"kind": "ramp", "duration": 1e-200, "smooth": True}), steps=DYN),
             "loads[0].time.duration", "expected a value >= 1e-09, found the number 1e-200",
             tmp_path, capsys)
 
 
 def test_time_functions_that_overflow_are_refused(tmp_path, capsys):
     for time, field, expected in [
-        ('{ kind = "sine", amplitude = 1.0, frequency = 1e300 }', "loads[0].time.frequency",
+        ({"kind": "sine", "amplitude": 1.0, "frequency": 1e300}, "loads[0].time.frequency",
          "expected a value <= 1000000000.0"),
-        ('{ kind = "sine", amplitude = 1e300, frequency = 1e6 }', "loads[0].time",
+        ({"kind": "sine", "amplitude": 1e300, "frequency": 1e6}, "loads[0].time",
          "its value, rate or second derivative overflows"),
-        ('{ kind = "ramp", duration = 1e-6, smooth = true, amplitude = 1e300 }',
+        ({"kind": "ramp", "duration": 1e-6, "smooth": True, "amplitude": 1e300},
          "loads[0].time", "overflows"),
-        ('{ kind = "table", t = [0.0, 1e-300], value = [0.0, 1.0] }', "loads[0].time",
+        ({"kind": "table", "t": [0.0, 1e-300], "value": [0.0, 1.0]}, "loads[0].time",
          "overflows"),
     ]:
         invalid(scene(timed(time), steps=DYN), field, expected, tmp_path, capsys,
@@ -275,7 +274,7 @@ def test_time_functions_that_overflow_are_refused(tmp_path, capsys):
 def test_a_short_smooth_ramp_runs_without_nan(tmp_path):
     import numpy as np
 
-    tree = valid(scene(timed('{ kind = "ramp", duration = 1e-3, smooth = true }'), steps=DYN),
+    tree = valid(scene(timed({"kind": "ramp", "duration": 1e-3, "smooth": True}), steps=DYN),
                  tmp_path)
     ds = tree["dyn"].to_dataset()
     assert ds.attrs["status"] == "completed"

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 import signal
 import subprocess
 import sys
@@ -30,9 +29,17 @@ import catdae
 import catdae.output.results
 from catdae.cli import main
 
-from scene_toml import cable_scene, long_transient, modal_step, static_step, transient_step
+from processes import interrupted_run, long_case
+from scene_toml import (
+    cable_scene,
+    load,
+    modal_step,
+    static_step,
+    support_motion,
+    transient_step,
+)
 
-PUSH = '[[loads]]\nname = "push"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
+PUSH = load("push", [0.0, 1.0, 0.0], node="c.1")
 
 
 def catdae_cli(*args, cwd, timeout=300, **kw) -> subprocess.CompletedProcess:
@@ -50,13 +57,6 @@ def short_dynamic(duration=0.2) -> str:
     """A static step, then a short transient of a pushed cable released (a second or two)."""
     return scene(PUSH, steps=static_step("st") + transient_step(
         "dyn", duration, 0.05, rtol=1e-5, atol=1e-8, remove=["push"]), elements=2)
-
-
-def long_case(path: Path, duration: float = 1000.0) -> Path:
-    """scene_toml.long_transient written to ``path``: a run of it is interrupted long before
-    its end."""
-    path.write_text(long_transient(duration))
-    return path
 
 
 def refused(proc: subprocess.CompletedProcess, *expected: str) -> str:
@@ -274,8 +274,7 @@ def test_study_workers_below_one_are_refused(tmp_path, workers, capsys):
 
 # -- 7. CSV tables: huge fields, values that overflow -------------------------------------------
 def table_load(file: str) -> str:
-    return ('[[loads]]\nname = "p"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
-            f'time = {{ kind = "table", file = "{file}" }}\n')
+    return load("p", [0.0, 1.0, 0.0], node="c.1", time={"kind": "table", "file": file})
 
 
 DYN = static_step("st") + transient_step("dyn", 0.2, 0.05, rtol=1e-6, atol=1e-8)
@@ -297,10 +296,11 @@ def test_table_values_near_the_largest_float_are_refused(tmp_path, values, capsy
     (tmp_path / "t.csv").write_text("".join(f"{k}.0,{x}\n" for k, x in enumerate(v)))
     case = tmp_path / "c.toml"
     for extra in (table_load("t.csv"),
-                  PUSH.replace("push", "p") + f"time = {{ kind = \"table\", t = [0.0, 1.0, "
-                  f"2.0], value = [{values}] }}\n",
-                  '[[support_motions]]\nnode = "A"\nx = { kind = "table", file = "t.csv", '
-                  'quantity = "acceleration" }\n'):
+                  load("p", [0.0, 1.0, 0.0], node="c.1",
+                       time={"kind": "table", "t": [0.0, 1.0, 2.0],
+                             "value": [float(x) for x in v]}),
+                  support_motion("A", x={"kind": "table", "file": "t.csv",
+                                         "quantity": "acceleration"})):
         case.write_text(scene(extra, steps=DYN))
         for cmd in ("check", "run"):
             refused(here(capsys, cmd, case), "its value, rate or second derivative overflows")
@@ -451,7 +451,7 @@ def test_the_output_may_not_be_a_table_file_of_the_case(tmp_path, capsys, monkey
     for out in (table, Path("points.csv")):
         refused(here(capsys, "run", case, "-o", out),
                 f"cannot write the results to {out}: it is a table file that the case reads")
-    motion = ('[[support_motions]]\nnode = "A"\nz = { kind = "table", file = "points.csv" }\n')
+    motion = support_motion("A", z={"kind": "table", "file": "points.csv"})
     case.write_text(scene(motion, steps=DYN))
     refused(catdae_cli("run", case, "-o", table, cwd=tmp_path), "a table file")
     assert table.read_bytes() == before
@@ -483,53 +483,8 @@ def test_plot_functions_raise_plot_error(three_kinds, tmp_path):
 
 
 # -- 16. SIGHUP -----------------------------------------------------------------------------------
-def run_until(proc, ready, timeout=180.0):
-    """Read the process's stderr in a thread until ``ready(text so far)`` holds; returns the
-    chunks read and the thread (reading on)."""
-    chunks: list[bytes] = []
-
-    def read_err():
-        while b := proc.stderr.read1(4096):
-            chunks.append(b)
-
-    reader = threading.Thread(target=read_err, daemon=True)
-    reader.start()
-    deadline = time.monotonic() + timeout
-    while not ready(b"".join(chunks).decode(errors="replace")):
-        assert proc.poll() is None, b"".join(chunks).decode(errors="replace")
-        assert time.monotonic() < deadline, b"".join(chunks).decode(errors="replace")
-        time.sleep(0.05)
-    return chunks, reader
-
-
-def stop(proc, sig, chunks, reader) -> tuple[int, str]:
-    """Send ``sig``; return (exit code, all of stderr)."""
-    proc.send_signal(sig)
-    try:
-        code = proc.wait(120)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    reader.join(30)
-    proc.stderr.close()
-    return code, b"".join(chunks).decode(errors="replace")
-
-
-def transient_runs(err: str) -> bool:
-    """The progress bar of the transient step shows that it has passed t = 1 s."""
-    shown = re.findall(r"dyn:.*?t=([0-9.]+)/", err)
-    return bool(shown) and float(shown[-1]) > 1.0
-
-
 def test_sighup_stops_a_run_like_sigterm(tmp_path):
-    case = long_case(tmp_path / "long.toml")
-    out = tmp_path / "long.nc"
-    proc = subprocess.Popen([sys.executable, "-m", "catdae", "run", str(case), "-o", str(out),
-                             "--progress"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            cwd=tmp_path, env=dict(os.environ, PYTHONUNBUFFERED="1"))
-    chunks, reader = run_until(proc, transient_runs)
-    code, err = stop(proc, signal.SIGHUP, chunks, reader)
+    code, err, out = interrupted_run(tmp_path, signal.SIGHUP)
     assert code == 129, err
     assert "Traceback" not in err and "catdae: interrupted by SIGHUP" in err
     tree = catdae.read_results(out)
@@ -801,3 +756,15 @@ def test_fuzz_foreign_result_files(data, three_kinds, tmp_path, capsys):
         err = capsys.readouterr().err
         assert code in (0, 2), (how, err)
         assert "Traceback" not in err and (code == 0) == (err == ""), (how, err)
+
+
+@pytest.mark.parametrize("x", [1e300, -2e7, 1.7976931348623157e308])
+def test_a_node_beyond_the_coordinate_limit_is_refused_by_name(tmp_path, capsys, x):
+    """A node at 1e300 m once overflowed inside form-finding (found by the fuzzer): node
+    coordinates are limited to ±1e7 m (docs/case-format.md, Limits), judged with the field."""
+    case = tmp_path / "far.toml"
+    case.write_text(scene(B=(x, 0.0, 0.0), L0=10.5))
+    refused(here(capsys, "check", case), "far.toml", "nodes.B[0]", "10000000")
+    inside = tmp_path / "inside.toml"  # the limit itself is a valid coordinate
+    inside.write_text(scene(A=(1e7 - 10.0, 0.0, 0.0), B=(1e7, 0.0, 0.0), L0=10.5))
+    assert here(capsys, "check", inside).returncode == 0

@@ -27,24 +27,14 @@ import catdae.analysis
 import catdae.output.results
 from catdae.cli import main
 
-from processes import catdae_process, signal_when, transient_runs
+from processes import catdae_process, interrupted_run, long_case, signal_when
 from repo_paths import CASES  # noqa: E402
-from scene_toml import long_transient
 
 THREE = CASES / "three_cables_shared_node.toml"
 
 
-def long_case(path: Path, duration: float = 1000.0) -> Path:
-    """``scene_toml.long_transient`` written to ``path``."""
-    path.write_text(long_transient(duration))
-    return path
-
-
 def test_sigterm_in_a_transient_step_keeps_and_marks_the_partial_results(tmp_path):
-    case = long_case(tmp_path / "long.toml")
-    out = tmp_path / "long.nc"
-    proc = catdae_process(["run", str(case), "-o", str(out), "--progress"], tmp_path)
-    code, err = signal_when(proc, signal.SIGTERM, transient_runs)
+    code, err, out = interrupted_run(tmp_path, signal.SIGTERM)
     assert code == 143, err
     assert "Traceback" not in err
     assert "catdae: interrupted by SIGTERM" in err

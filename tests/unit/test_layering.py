@@ -65,3 +65,33 @@ def test_no_import_points_back_up_the_pipeline(path):
 def test_every_stage_is_ranked():
     stages = {p.relative_to(PACKAGE).parts[0].removesuffix(".py") for p in MODULES}
     assert stages <= set(RANK), stages - set(RANK)
+
+
+def test_no_module_over_400_lines():
+    """A module a newcomer can read in one sitting (issue 20): none over 400 lines."""
+    long = {str(p.relative_to(PACKAGE)): n for p in MODULES
+            if (n := len(p.read_text().splitlines())) > 400}
+    assert not long, long
+
+
+def test_no_solver_function_over_60_lines():
+    """The solver drivers read as named phases (issue 20): no function in catdae/solvers is
+    longer than 60 lines (decorators and docstring included)."""
+    long = {}
+    for p in sorted((PACKAGE / "solvers").glob("*.py")):
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                first = min([node.lineno] + [d.lineno for d in node.decorator_list])
+                if node.end_lineno - first + 1 > 60:
+                    long[f"{p.name}:{node.name}"] = node.end_lineno - first + 1
+    assert not long, long
+
+
+def test_no_private_name_is_imported_across_modules():
+    """A name another module imports is part of its module's interface, so it is public: no
+    ``from catdae.x import _name`` (``import x as _alias`` of a public name is fine)."""
+    private = [f"{p.relative_to(PACKAGE)}:{node.lineno} {node.module}.{a.name}"
+               for p in MODULES for node in ast.walk(ast.parse(p.read_text()))
+               if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("catdae")
+               for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not private, private

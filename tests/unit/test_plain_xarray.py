@@ -15,41 +15,14 @@ import xarray as xr
 
 import catdae
 
-CASE = """
-[materials.wire]
-EA = 3.4e7
-mass = 5.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 1.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "cable"
-ends = ["A", "B"]
-material = "wire"
-length = 11.0
-elements = 4
-[[loads]]
-name = "tap"
-node = "cable.2"
-force = [0.0, 20.0, -30.0]
-time = { kind = "ramp", duration = 0.02 }
-[[steps]]
-kind = "static"
-name = "first"
-[[steps]]
-kind = "transient"
-name = "tapped"
-duration = 0.1
-output_interval = 0.025
-[[steps]]
-kind = "transient"
-name = "later"
-duration = 0.05
-output_interval = 0.025
-"""
+from scene_toml import cable_scene, load, static_step, step
+
+CASE = cable_scene(
+    B=(10.0, 0.0, 1.0), L0=11.0, EA=3.4e7, mass=5.0, elements=4, material="wire", cable="cable",
+    extra=load("tap", [0.0, 20.0, -30.0], node="cable.2",
+               time={"kind": "ramp", "duration": 0.02}),
+    steps=(static_step("first") + step("transient", "tapped", duration=0.1, output_interval=0.025)
+           + step("transient", "later", duration=0.05, output_interval=0.025)))
 
 
 def test_plain_xarray_gives_float_seconds(tmp_path):

@@ -12,33 +12,11 @@ import catdae
 from catdae.cli import main
 from catdae.output import plot
 
-CASE = """
-[materials.m]
-EA = 1.0e6
-mass = 1.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [12.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "main"
-ends = ["A", "B"]
-material = "m"
-length = 12.3
-elements = 4
-[[loads]]
-name = "push"
-cable = "main"
-s = 6.15
-force = [0.0, 5.0, 0.0]
-[[steps]]
-kind = "transient"
-name = "pushed"
-duration = 0.05
-output_interval = 0.01
-"""
+from scene_toml import cable_scene, load, step
+
+CASE = cable_scene(B=(12.0, 0.0, 0.0), L0=12.3, EA=1.0e6, mass=1.0, elements=4, cable="main",
+                   extra=load("push", [0.0, 5.0, 0.0], cable="main", s=6.15),
+                   steps=step("transient", "pushed", duration=0.05, output_interval=0.01))
 
 
 @pytest.fixture(scope="module")

@@ -21,6 +21,8 @@ from numba.core import event
 
 from catdae.progress import LogProgress, announce_compiling, reporter
 
+from scene_toml import cable_scene, step
+
 LINE = re.compile(r"catdae: (\w+): t = ([0-9.e+-]+) / ([0-9.e+-]+) s \((\d+) %\), "
                   r"([0-9.]+) s wall(, compiling the kernels)?(, done)?$")
 
@@ -76,12 +78,9 @@ def test_a_reporter_for_a_log_ticks_and_stops(monkeypatch):
 
 def test_catdae_run_into_a_log_file(tmp_path):
     case = tmp_path / "c.toml"
-    case.write_text(
-        '[materials.m]\nEA = 1.0e6\nmass = 1.0\n[nodes]\nA = [0.0, 0.0, 0.0]\n'
-        'B = [10.0, 0.0, 0.0]\n[supports]\nA = "pinned"\nB = "pinned"\n'
-        '[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "m"\nlength = 10.5\n'
-        'elements = 6\n[[steps]]\nkind = "transient"\nname = "swing"\nduration = 2.0\n'
-        'output_interval = 0.01\n')
+    case.write_text(cable_scene(B=(10.0, 0.0, 0.0), L0=10.5, EA=1.0e6, mass=1.0, elements=6,
+                                steps=step("transient", "swing", duration=2.0,
+                                           output_interval=0.01)))
     log = tmp_path / "log"
     env = dict(os.environ, CATDAE_LOG_INTERVAL="0.02")
     with open(log, "w") as f:

@@ -94,10 +94,10 @@ def test_after_the_record_the_support_keeps_its_last_velocity():
 # ---------------------------------------------------------------------------------------------
 # Through the case format: a support driven by an acceleration record in a multi-column CSV
 # ---------------------------------------------------------------------------------------------
-def record_scene(tmp_path, dt, motion_line):
+def record_scene(tmp_path, dt, motion_y):
     """The taut string with a heavy midspan mass of tests/scenes/test_loads.py, support A moving
-    in y."""
-    from scene_toml import cable_scene, transient_step
+    in y as the time function ``motion_y`` (a mapping) says."""
+    from scene_toml import cable_scene, point_mass, support_motion, transient_step
 
     ts = np.linspace(0.0, 1.0, int(round(1.0 / dt)) + 1)
     u, v, a = motion(ts)
@@ -105,8 +105,8 @@ def record_scene(tmp_path, dt, motion_line):
                      for tk, ak, vk in zip(ts, a, v, strict=True))
     (tmp_path / "record.csv").write_text("# a synthetic record\nt,ax,ay,vy\n" + rows + "\n")
     text = cable_scene(B=(10.0, 0.0, 0.0), L0=9.99, EA=1e7, mass=0.01, elements=2, gravity=0.0,
-                       extra=('[[point_masses]]\nname = "M"\nnode = "c.1"\nmass = 100.0\n'
-                              f'[[support_motions]]\nnode = "A"\ny = {motion_line}\n'),
+                       extra=(point_mass("M", 100.0, node="c.1")
+                              + support_motion("A", y=motion_y)),
                        steps=transient_step("shake", 1.0, 0.01, rtol=1e-9, atol=1e-12))
     case = tmp_path / f"shake-{dt}.toml"
     case.write_text(text)
@@ -114,16 +114,16 @@ def record_scene(tmp_path, dt, motion_line):
 
 
 def test_acceleration_record_drives_the_support_as_its_analytic_motion(tmp_path):
-    exact = record_scene(tmp_path, 0.01, f"{{ kind = \"cosine\", amplitude = {-A!r}, "
-                                         f"frequency = {W / (2 * math.pi)!r}, offset = {A!r} }}")
+    exact = record_scene(tmp_path, 0.01, {"kind": "cosine", "amplitude": -A,
+                                          "frequency": W / (2 * math.pi), "offset": A})
     t = exact["time"].values
     np.testing.assert_allclose(exact["displacement"].sel(node="A", axis="y"), motion(t)[0],
                                atol=1e-15)
-    line = '{ kind = "table", file = "record.csv", column = "ay", quantity = "acceleration" }'
+    record = {"kind": "table", "file": "record.csv", "column": "ay", "quantity": "acceleration"}
     errs_a, errs_m = [], []
     dts = np.array([0.02, 0.01, 0.005])
     for dt in dts:
-        ds = record_scene(tmp_path, dt, line)
+        ds = record_scene(tmp_path, dt, record)
         ua = ds["displacement"].sel(node="A", axis="y").values
         # the support follows the integrated record: within the interpolation bound
         errs_a.append(np.abs(ua - motion(t)[0]).max())
@@ -140,34 +140,33 @@ def test_acceleration_record_drives_the_support_as_its_analytic_motion(tmp_path)
 def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
     from catdae.cli import main
 
-    from scene_toml import cable_scene, transient_step
+    from scene_toml import cable_scene, load, support_motion, transient_step
 
     (tmp_path / "three.csv").write_text("t,ax,ay\n0.0,0.0,1.0\n1.0,0.0,2.0\n")
     (tmp_path / "bare.csv").write_text("0.0,0.0,1.0\n1.0,0.0,2.0\n")
     motions = [
-        ('x = { kind = "table", file = "three.csv", column = "ayy", quantity = "acceleration" }',
+        ({"kind": "table", "file": "three.csv", "column": "ayy", "quantity": "acceleration"},
          "support_motions[0].x.column: three.csv has no column 'ayy'; did you mean 'ay'? (its "
          "columns: t, ax, ay; time is the first)"),
-        ('x = { kind = "table", file = "three.csv" }',
+        ({"kind": "table", "file": "three.csv"},
          "support_motions[0].x.file: three.csv has 3 columns (t, ax, ay): choose the value "
          'column with column = "<name>"'),
-        ('x = { kind = "table", file = "bare.csv", column = "ax" }',
+        ({"kind": "table", "file": "bare.csv", "column": "ax"},
          "support_motions[0].x.column: column = 'ax' needs a header line in bare.csv"),
-        ('x = { kind = "table", t = [0.0, 1.0], value = [0.0, 1.0], column = "ax" }',
+        ({"kind": "table", "t": [0.0, 1.0], "value": [0.0, 1.0], "column": "ax"},
          "support_motions[0].x.column: column selects a column of a table file"),
-        ('x = { kind = "table", file = "three.csv", column = "t" }',
+        ({"kind": "table", "file": "three.csv", "column": "t"},
          "support_motions[0].x.column: 't' is the time column"),
-        ('x = { kind = "table", file = "three.csv", column = "ax", quantity = "jerk" }',
+        ({"kind": "table", "file": "three.csv", "column": "ax", "quantity": "jerk"},
          "support_motions[0].x.quantity:"),
     ]
-    for line, message in motions:
+    velocity = {"kind": "table", "t": [0.0, 1.0], "value": [0.0, 1.0], "quantity": "velocity"}
+    for x, message in motions:
         case = tmp_path / "bad.toml"
         case.write_text(cable_scene(
             B=(10.0, 0.0, 0.0), L0=10.2, EA=1e7, mass=1.0, elements=2,
-            extra=f'[[support_motions]]\nnode = "A"\n{line}\n'
-                  '[[loads]]\nname = "P"\nnode = "c.1"\nforce = [0.0, 1.0, 0.0]\n'
-                  'time = { kind = "table", t = [0.0, 1.0], value = [0.0, 1.0], '
-                  'quantity = "velocity" }\n',
+            extra=(support_motion("A", x=x)
+                   + load("P", [0.0, 1.0, 0.0], node="c.1", time=velocity)),
             steps=transient_step("s", 1.0, 0.1, rtol=1e-6, atol=1e-8)))
         assert main(["check", str(case)]) == 2
         err = capsys.readouterr().err
@@ -177,16 +176,16 @@ def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
 
 
 def test_velocity_and_displacement_columns_through_the_case_format(tmp_path):
-    from scene_toml import cable_scene, static_step
+    from scene_toml import cable_scene, static_step, support_motion
 
     ts = np.linspace(0.0, 1.0, 101)
     u, v, a = motion(ts)
     rows = "\n".join(",".join(repr(float(x)) for x in r) for r in zip(ts, u, v, a, strict=True))
     (tmp_path / "m.csv").write_text("time,ux,vx,ax\n" + rows + "\n")
-    extra = ('[[support_motions]]\nnode = "A"\n'
-             'x = { kind = "table", file = "m.csv", column = "vx", quantity = "velocity" }\n'
-             'y = { kind = "table", file = "m.csv", column = "ux" }\n'
-             'z = { kind = "table", file = "m.csv", column = "ax", quantity = "acceleration" }\n')
+    extra = support_motion(
+        "A", x={"kind": "table", "file": "m.csv", "column": "vx", "quantity": "velocity"},
+        y={"kind": "table", "file": "m.csv", "column": "ux"},
+        z={"kind": "table", "file": "m.csv", "column": "ax", "quantity": "acceleration"})
     case_file = tmp_path / "c.toml"
     case_file.write_text(cable_scene(B=(10.0, 0.0, 0.0), L0=10.2, EA=1e7, mass=1.0, elements=2,
                                      extra=extra, steps=static_step()))

@@ -18,7 +18,7 @@ from catdae.case import load_case
 from catdae.study import StudyError, convergence_order, run_study
 
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, modal_step, static_step
+from scene_toml import cable_scene, falling_mass, modal_step, static_step
 
 GENTLE = CASES / "example2_support_motion_gentle.toml"
 EXAMPLE1 = CASES / "example1_free_vibration.toml"
@@ -274,32 +274,7 @@ def test_peak_tension_error_shrinks_as_the_tolerance_tightens():
     """A mass falling onto a rope (the snap of tests/scenes/test_axial_damping.py): the error
     of the step's largest tension (from the tension envelope) against the reference run
     shrinks as rtol tightens, and a reference given as results gives the same errors."""
-    text = """
-[materials.rope]
-EA = 1e7
-mass = 0.1
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [0.3, 0.0, -9.5]
-[supports]
-A = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "rope"
-length = 10.0
-elements = 1
-[[point_masses]]
-name = "bob"
-node = "B"
-mass = 1000.0
-[[steps]]
-kind = "transient"
-name = "drop"
-mass_model = "lumped"
-duration = 0.4
-output_interval = 0.05
-"""
+    text = falling_mass(0.1, duration=0.4)  # the rope's mass 1e-3 of the bob's
     kw = dict(rtol=[1e-2, 1e-4, 1e-6], atol=[1e-9], scheduler="synchronous")
     ds = run_study(text, **kw)
     assert (ds.status.values == "completed").all()

@@ -10,36 +10,12 @@ import pytest
 
 from catdae.study import StudyError, main, run_study
 
-CASE = """
-[materials.m]
-EA = 2.0e7
-mass = 2.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [100.0, 0.0, 20.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 104.0
-elements = 4
-[[distributed_loads]]
-name = "snow"
-cable = "c"
-load = [0.0, 0.0, -80.0]
-from_s = 11.0
-to_s = 58.5
-[[steps]]
-kind = "static"
-name = "loaded"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 4
-"""
+from scene_toml import cable_scene, distributed_load, modal_step, static_step
+
+CASE = cable_scene(B=(100.0, 0.0, 20.0), L0=104.0, EA=2.0e7, mass=2.0, elements=4,
+                   extra=distributed_load("c", [0.0, 0.0, -80.0], name="snow", from_s=11.0,
+                                          to_s=58.5),
+                   steps=static_step("loaded") + modal_step(4))
 
 
 @pytest.mark.parametrize("response", ["end_tension:c:j", "horizontal_tension:c"])

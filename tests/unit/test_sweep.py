@@ -11,47 +11,23 @@ import pytest
 import catdae
 from catdae.case import case_from_dict
 
-SPRING = """title = "a weight on a spring"
-gravity = 0.0
-[nodes]
-G = [0.0, 0.0, 0.0]
-N = [0.0, 0.0, -1.0]
-[supports]
-G = "pinned"
-N = ["x", "y"]
-[[springs]]
-name = "k"
-ends = ["G", "N"]
-stiffness = 1000.0
-[[dampers]]
-name = "d"
-ends = ["G", "N"]
-coefficient = 10.0
-[[point_masses]]
-name = "m"
-node = "N"
-mass = 4.0
-[[loads]]
-name = "P"
-node = "N"
-force = [0.0, 0.0, -100.0]
-"""
+from scene_toml import damper, load, point_mass, scene, spring, step
+
+SPRING = scene(head={"title": "a weight on a spring", "gravity": 0.0}, materials={},
+               nodes={"G": (0.0, 0.0, 0.0), "N": (0.0, 0.0, -1.0)},
+               supports=("G", 'N = ["x", "y"]'), cables="",
+               extra=(spring("k", ["G", "N"], 1000.0) + damper("d", ["G", "N"], 10.0)
+                      + point_mass("m", 4.0, node="N") + load("P", [0.0, 0.0, -100.0], node="N")))
 
 
 def test_load_factor_and_coefficient_sweeps_against_closed_forms():
     """A mass m on a spring k (rest length 1 m, along z) under a load f P: the spring stretches
     by f P / k exactly; the damped mode has ζ = c / (2 √(k m)) whatever the stretch (the spring
     and damper act along the same line), for each swept coefficient."""
-    text = SPRING + """[[steps]]
-kind = "static"
-name = "loads"
-sweep = { field = "load_factor", values = [0.5, 1.0, 2.0] }
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 1
-sweep = { field = "dampers.d.coefficient", values = [0.0, 10.0, 40.0] }
-"""
+    text = SPRING + step("static", "loads",
+                         sweep={"field": "load_factor", "values": [0.5, 1.0, 2.0]}) + step(
+        "modal", "modes", modes=1,
+        sweep={"field": "dampers.d.coefficient", "values": [0.0, 10.0, 40.0]})
     tree = catdae.run(case_from_dict(tomllib.loads(text)))
     st = tree["loads"].ds
     assert st.sweep.attrs["units"] == "1" and st.attrs["sweep_field"] == "load_factor"
@@ -71,20 +47,20 @@ sweep = { field = "dampers.d.coefficient", values = [0.0, 10.0, 40.0] }
 
 
 @pytest.mark.parametrize(("sweep", "field", "words"), [
-    ('{ field = "dampers.nobody.coefficient", values = [1.0] }', "steps[0].sweep.field",
+    ({"field": "dampers.nobody.coefficient", "values": [1.0]}, "steps[0].sweep.field",
      "unknown damper 'nobody'"),
-    ('{ field = "dampers.d.colour", values = [1.0] }', "steps[0].sweep.field",
+    ({"field": "dampers.d.colour", "values": [1.0]}, "steps[0].sweep.field",
      "expected one of ['temperature_change', 'load_factor'"),
-    ('{ field = "dampers.d.coefficient", values = [1.0, -2.0] }', "steps[0].sweep.values[1]",
+    ({"field": "dampers.d.coefficient", "values": [1.0, -2.0]}, "steps[0].sweep.values[1]",
      "expected a value >= 0 for dampers.d.coefficient, found the number -2.0"),
-    ('{ field = "load_factor", values = [] }', "steps[0].sweep.values",
+    ({"field": "load_factor", "values": []}, "steps[0].sweep.values",
      "expected a non-empty list of finite numbers"),
 ])
 def test_bad_sweeps_are_located(sweep, field, words, tmp_path, capsys):
     from catdae.cli import main
 
     f = tmp_path / "bad.toml"
-    f.write_text(SPRING + f'[[steps]]\nkind = "static"\nsweep = {sweep}\n')
+    f.write_text(SPRING + step("static", sweep=sweep))
     assert main(["check", str(f)]) == 2
     err = capsys.readouterr().err
     assert f"{f}: {field}: {words}" in err, err

@@ -19,6 +19,8 @@ from catdae.case.timefunc_compose import Product, Trapezoid
 from catdae.cli import main
 from catdae.errors import CaseError
 
+from scene_toml import cable_scene, step, support_motion, value
+
 
 def _fd(f, t, h=1e-5):
     v = [f.evaluate(t + k * h)[0] for k in (-1, 0, 1)]
@@ -61,39 +63,24 @@ def test_trapezoid(smooth):
         assert f.evaluate(0.2)[1] == pytest.approx(15.0) and f.evaluate(1.0)[1] == -7.5
 
 
-CASE = """
-[materials.m]
-EA = 1.0e6
-mass = 1.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = {b_support}
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-length = 10.5
-elements = 4
-[[support_motions]]
-node = "B"
-{motion}
-[[steps]]
-kind = "transient"
-name = "shake"
-duration = 0.4
-output_interval = 0.05
-"""
+def case(motion: dict, b_support="pinned") -> str:
+    """A 10 m span (10.5 m of cable, 4 elements) whose end B (held as ``b_support`` says) moves
+    as ``motion`` (the fields of its support motion) in the transient "shake"."""
+    return cable_scene(B=(10.0, 0.0, 0.0), L0=10.5, EA=1.0e6, mass=1.0, elements=4,
+                       supports=("A", f"B = {value(b_support)}"),
+                       extra=support_motion("B", **motion),
+                       steps=step("transient", "shake", duration=0.4, output_interval=0.05))
+
+
+CONSTANT = {"kind": "constant", "value": 1.0}
 
 
 def test_support_moves_along_its_direction():
-    motion = ('direction = [3.0, 0.0, 4.0]\nvalue = { kind = "product", factors = [\n'
-              '  { kind = "sine", amplitude = 0.2, frequency = 2.0 },\n'
-              '  { kind = "ramp", duration = 0.3, smooth = true } ] }\n')
-    tree = catdae.run(catdae.load_case(CASE.format(b_support='"pinned"', motion=motion)),
-                      progress=False)
+    motion = {"direction": [3.0, 0.0, 4.0],
+              "value": {"kind": "product", "factors": [
+                  {"kind": "sine", "amplitude": 0.2, "frequency": 2.0},
+                  {"kind": "ramp", "duration": 0.3, "smooth": True}]}}
+    tree = catdae.run(catdae.load_case(case(motion)), progress=False)
     ds = tree["shake"].ds
     t = ds.time.values
     x = Product((Sine(0.2, 2.0), Ramp(0.3, 0.0, True)))(t)
@@ -104,21 +91,22 @@ def test_support_moves_along_its_direction():
 
 
 @pytest.mark.parametrize(("support", "motion", "where", "words"), [
-    ('"pinned"', 'direction = [1.0, 0.0, 0.0]\nvalue = { kind = "constant", value = 1.0 }\n'
-     'x = { kind = "constant", value = 1.0 }\n', "support_motions[0]", "not both"),
-    ('"pinned"', 'direction = [0.0, 0.0, 0.0]\nvalue = { kind = "constant", value = 1.0 }\n',
+    ("pinned", {"direction": [1.0, 0.0, 0.0], "value": CONSTANT, "x": CONSTANT},
+     "support_motions[0]", "not both"),
+    ("pinned", {"direction": [0.0, 0.0, 0.0], "value": CONSTANT},
      "support_motions[0].direction", "non-zero length"),
-    ('["x", "z"]', 'direction = [1.0, 1.0, 0.0]\nvalue = { kind = "constant", value = 1.0 }\n',
+    (["x", "z"], {"direction": [1.0, 1.0, 0.0], "value": CONSTANT},
      "support_motions[0].direction", "axis 'y'"),
-    ('"pinned"', 'direction = [1.0, 0.0, 0.0]\n', "support_motions[0].value", "missing"),
-    ('"pinned"', 'direction = [1.0, 0.0, 0.0]\nvalue = { kind = "trapezoid", rise = 0.1 }\n',
+    ("pinned", {"direction": [1.0, 0.0, 0.0]}, "support_motions[0].value", "missing"),
+    ("pinned", {"direction": [1.0, 0.0, 0.0], "value": {"kind": "trapezoid", "rise": 0.1}},
      "support_motions[0].value.fall", "missing"),
-    ('"pinned"', 'x = { kind = "product", factors = [{ kind = "sine", amplitude = 1.0, '
-     'frequency = 1.0 }] }\n', "support_motions[0].x.factors", "at least 2"),
+    ("pinned", {"x": {"kind": "product", "factors": [
+        {"kind": "sine", "amplitude": 1.0, "frequency": 1.0}]}},
+     "support_motions[0].x.factors", "at least 2"),
 ])
 def test_bad_directed_motions_are_named(support, motion, where, words, tmp_path, capsys):
     path = tmp_path / "bad.toml"
-    path.write_text(CASE.format(b_support=support, motion=motion))
+    path.write_text(case(motion, support))
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert where in err and words in err, err
