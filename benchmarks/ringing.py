@@ -10,6 +10,12 @@ Whole ``python -m catdae run`` processes (wall and CPU of the child), one after 
   the tension envelope (``tension_max``) against 264 kN (time-converged; OpenSees 263.9 kN).
 - ``snap``: a mass falling h onto a rope of vanishing mass: T_max = Mg + sqrt((Mg)² +
   2 Mg EA h / L) from the envelope.
+- ``stay``: an inclined bridge stay (200 m chord at 30°, EA 1.6e9 N, 80 kg/m, pretension
+  6.27 MN: first out-of-plane mode 0.703 Hz, λ² about 0.1), 20 elements, nudged out of plane by
+  2 kN at midspan, then driven at its deck anchor along the chord, 0.05 sin(2π 1.4 t) m under a
+  2 s smooth ramp (the tension varies by ±6 %: parametric 2:1 resonance of the out-of-plane
+  mode), 60 s at rtol 1e-5: the growth rate of the out-of-plane midspan amplitude (log-linear
+  fit of its peaks from 5 s on) against a run at rtol 1e-7.
 
 ``python benchmarks/ringing.py pendulum violent snap`` prints Markdown table rows (see
 benchmarks/ringing.md); ``--duration`` shortens the violent scene, ``--rows`` picks variants.
@@ -124,6 +130,7 @@ def run_case(text: str, folder: Path, name: str, *extra_args: str):
 
 PENDULUM_ROWS = {
     "default": "",
+    'resolve = "waves" (the former default)': 'resolve = "waves"',
     "axial 50 % (element)": 'axial_damping = { ratio = 0.5, frequency = "element" }',
     "axial 5 % (element)": 'axial_damping = { ratio = 0.05, frequency = "element" }',
     "rtol 1e-4, atol 1e-6": "rtol = 1e-4\natol = 1e-6",
@@ -135,11 +142,91 @@ VIOLENT_ROWS = {
     "rtol 3e-3, atol 3e-5": ("", ["--rtol", "3e-3", "--atol", "3e-5"]),
     "rtol 5e-3, atol 1e-4": ("", ["--rtol", "5e-3", "--atol", "1e-4"]),
     "rtol 5e-3, atol 1e-4, max_order 2": ("max_order = 2", ["--rtol", "5e-3", "--atol", "1e-4"]),
+    "case (rtol 1e-5, atol 1e-6)": ("", []),
+    "case, resolve output": ('resolve = "output"', []),
     "rtol 1e-3, axial 0.5 % (element)": ('axial_damping = { ratio = 0.005 }',
                                           ["--rtol", "1e-3", "--atol", "1e-6"]),
     "rtol 1e-3, axial 5 % (element)": ('axial_damping = { ratio = 0.05 }',
                                         ["--rtol", "1e-3", "--atol", "1e-6"]),
 }
+
+
+STAY_L, STAY_INC, STAY_EA, STAY_M, STAY_T = 200.0, 30.0, 1.6e9, 80.0, 6.27e6
+
+
+def stay_case(step_extra: str = "", duration: float = 60.0, elements: int = 20,
+              amplitude: float = 0.05, frequency: float = 1.4) -> str:
+    """The stay: a static step nudged out of plane, then the anchor A driven along the chord."""
+    bx = STAY_L * math.cos(math.radians(STAY_INC))
+    bz = STAY_L * math.sin(math.radians(STAY_INC))
+    rtol = "" if "rtol" in step_extra else "rtol = 1e-5\n"
+    motion = (f'{{ kind = "product", factors = [{{ kind = "sine", amplitude = {amplitude!r}, '
+              f'frequency = {frequency!r} }}, '
+              '{ kind = "ramp", duration = 2.0, smooth = true }] }')
+    return f"""title = "bridge stay driven at its deck anchor (parametric 2:1)"
+[materials.strand]
+EA = {STAY_EA!r}
+mass = {STAY_M!r}
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [{bx!r}, 0.0, {bz!r}]
+[supports]
+A = "pinned"
+B = "pinned"
+[[cables]]
+name = "stay"
+ends = ["A", "B"]
+material = "strand"
+elements = {elements}
+form = {{ pretension = {STAY_T!r} }}
+[[loads]]
+name = "nudge"
+node = "stay.{elements // 2}"
+force = [0.0, 2000.0, 0.0]
+[[support_motions]]
+node = "A"
+direction = [{bx!r}, 0.0, {bz!r}]
+value = {motion}
+[[steps]]
+kind = "static"
+name = "nudged"
+[[steps]]
+kind = "transient"
+name = "driven"
+remove = ["nudge"]
+duration = {duration!r}
+output_interval = 0.02
+{rtol}{step_extra}
+"""
+
+
+def stay_growth(ds, t_from: float = 5.0) -> float:
+    """Growth rate (1/s) of the out-of-plane midspan amplitude: a log-linear fit of the peaks of
+    |y| from ``t_from`` on."""
+    t = ds.time.values
+    a = np.abs(ds.position.sel(node="stay.10", axis="y").values)
+    pk = np.flatnonzero((a[1:-1] > a[:-2]) & (a[1:-1] >= a[2:])) + 1
+    w = t[pk] >= t_from
+    return float(np.polyfit(t[pk][w], np.log(a[pk][w]), 1)[0])
+
+
+STAY_ROWS = {
+    "rtol 1e-7 (reference)": "rtol = 1e-7\natol = 1e-9",
+    "default (rtol 1e-5)": "",
+    'resolve = "waves" (the former default)': 'resolve = "waves"',
+}
+
+
+def stay(folder: Path, rows) -> None:
+    print("| stay, 20 elements, 60 s | steps | CPU s | wall s | growth rate 1/s | vs reference |")
+    print("|---|---:|---:|---:|---:|---:|")
+    ref = None
+    for label in rows:
+        ds, wall, cpu = run_case(stay_case(STAY_ROWS[label]), folder, "stay")
+        sigma = stay_growth(ds)
+        ref = sigma if ref is None else ref
+        print(f"| {label} | {ds.attrs['n_steps']} | {cpu:.1f} | {wall:.1f} | {sigma:.5f} | "
+              f"{100 * (sigma / ref - 1):+.2f} % |", flush=True)
 
 
 def pendulum(folder: Path, rows) -> None:
@@ -213,7 +300,7 @@ def snap(folder: Path) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("scenes", nargs="*", default=["pendulum", "violent", "snap"])
+    ap.add_argument("scenes", nargs="*", default=["pendulum", "stay", "violent", "snap"])
     ap.add_argument("--duration", type=float, default=4.0, help="of the violent scene, s")
     ap.add_argument("--rows", nargs="*", help="variants (labels of the tables) to run")
     args = ap.parse_args()
@@ -222,6 +309,8 @@ def main() -> None:
         folder = Path(tmp)
         if "pendulum" in args.scenes:
             pendulum(folder, args.rows or list(PENDULUM_ROWS))
+        if "stay" in args.scenes:
+            stay(folder, args.rows or list(STAY_ROWS))
         if "violent" in args.scenes:
             violent(folder, args.rows or list(VIOLENT_ROWS), args.duration)
         if "snap" in args.scenes:

@@ -24,6 +24,7 @@ from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutOfMemory
 from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
+from catdae.model.snap import snap_reason
 from catdae.model.span import span_quantities
 from catdae.output import engineering, results
 from catdae.output.connectors import with_connector_forces, with_damped_modes
@@ -42,6 +43,7 @@ class _State:
         self.X = X  # (n_nodes, 3) m
         self.V = np.zeros_like(X)  # (n_nodes, 3) m/s
         self.h: np.ndarray | None = None  # (n_elem, 3) N, warm start
+        self.snap = ""  # the step that took the lumped mass for a snap (auto), if the last
         self.t = 0.0
 
 
@@ -90,8 +92,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
                 ds, temperature = _sweep_step(step, local, mesh, absent, temperature, state,
                                               progress)
             else:
-                model = Model(local, mesh.heated(local, temperature), absent,
-                              mass_model=step.mass_model, kind=step.kind)
+                model = step_model(local, mesh.heated(local, temperature), absent, step,
+                                   state)
                 ds = _run_step(step, model, state, writer, progress)
             ds = engineering_results(step, rotate_back(ds, rotation), case, groups,
                                      temperature)
@@ -185,8 +187,7 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
         case_v, step_v = apply_sweep(case, step, value)
         temp_v = temperature if step_v.temperature_change is None else step_v.temperature_change
         run_state = copy.deepcopy(start)
-        model = Model(case_v, mesh.heated(case_v, temp_v), absent, mass_model=step.mass_model,
-                      kind=step.kind)
+        model = step_model(case_v, mesh.heated(case_v, temp_v), absent, step, run_state)
         groups.append(_run_step(step_v, model, run_state, None, progress))
     state.__dict__.update(run_state.__dict__)
     field = step.sweep.field
@@ -198,6 +199,21 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
     ds = ds.assign_coords(sweep=xr.Variable("sweep", np.array(step.sweep.values), {
         "units": sweep_units(field), "long_name": f"swept value of {field}"}))
     return ds.assign_attrs(sweep_field=field), temp_v
+
+
+def step_model(case: Case, mesh, absent: set[str], step: Step, state: _State) -> Model:
+    """The model of a step. A transient with ``mass_model = "auto"`` that can snap from the
+    state it starts in (catdae.model.snap) gets a mass that carries the axial wave, and its
+    ``mass_model_choice`` says why."""
+    model = Model(case, mesh, absent, mass_model=step.mass_model, kind=step.kind)
+    if step.kind == "transient" and step.mass_model == "auto" and model.mass_model.catenary:
+        reason = snap_reason(model, step, state.X, state.V, state.t, state.h)
+        if not reason and state.snap and np.any(state.V):  # its wave is still travelling
+            reason = f"it continues step '{state.snap}', which took it for a snap"
+        if reason:
+            model = Model(case, mesh, absent, mass_model="auto", kind=step.kind, snap=reason)
+    state.snap = step.name if model.mass_model.snap else ""
+    return model
 
 
 def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.Dataset:

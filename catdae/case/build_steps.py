@@ -171,6 +171,7 @@ class StepsPass:
                          "max_order": v.max_order, "linear_solver": v.linear_solver,
                          "mass_model": v.mass_model, "inertia": v.inertia,
                          "axial_damping": self.axial_damping(v.axial_damping, where),
+                         "resolve": v.resolve,
                          "jump_reference": self.jump_reference(v, where, out)}
             temperature = self.step_temperature(v, where)
             sweep = self.sweep(v.sweep, where, self.connector_items)

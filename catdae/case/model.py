@@ -234,7 +234,8 @@ class Step:
     ``mass_model``, ``inertia`` ("lagrangian": M(q) v' plus the velocity terms of Lagrange's
     equations for T = ½ vᵀ M(q) v, which conserve energy; "paper": M(q) v' alone, the form of
     Chang, Park & Lee 2008, which does not), ``axial_damping`` (strain-rate damping, None:
-    none).
+    none), ``resolve`` (which motion IDA's error test follows: "output", "waves" or "auto";
+    catdae.solvers.tolerance).
     """
 
     kind: Literal["static", "modal", "transient"]
@@ -256,6 +257,7 @@ class Step:
     jump_reference: str | None = None  # transient: an earlier static step (jump_height)
     sweep: Sweep | None = None
     axial_damping: AxialDamping | None = None
+    resolve: Literal["auto", "output", "waves"] = "auto"
 
     def __post_init__(self):
         if isinstance(self.temperature_change, Mapping):

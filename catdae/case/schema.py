@@ -167,6 +167,7 @@ class _TransientStep(BaseModel):
     jump_reference: Name | None = None  # an earlier static step: jump_height results
     sweep: TomlTable | None = None
     axial_damping: TomlTable | None = None
+    resolve: Literal["auto", "output", "waves"] = "auto"
 
 
 class FormSchema(BaseModel):

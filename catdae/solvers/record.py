@@ -78,6 +78,10 @@ def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
 
 def note(model: Model, prob) -> str:
     """Advice on the result's accuracy that the run itself found ("" when none)."""
+    if model.mass_model.snap:
+        return ("mass_model \"auto\" chose \"lumped\", a mass that carries axial (snap) waves, "
+                f"because {model.mass_model.snap}; give mass_model = \"blended\" where no snap "
+                "is expected (smooth motion converges faster with it; docs/accuracy.md)")
     if not model.mass_model.catenary:
         return ""
     jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]

@@ -23,6 +23,7 @@ from sksundae.ida import IDA
 
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
+from catdae.model.snap import velocity_jumps
 from catdae.progress import reporter
 from catdae.solvers.order import (
     OrderChoice,
@@ -31,6 +32,7 @@ from catdae.solvers.order import (
 )
 from catdae.solvers.record import OutputRecord, note
 from catdae.solvers.residual import TransientProblem
+from catdae.solvers.tolerance import error_weights, resolve_mode
 
 __all__ = ["IDA", "OrderChoice", "TransientProblem", "choose_solver", "run_transient"]
 
@@ -98,6 +100,7 @@ class _Run:
         self.dt_out = float(step.output_interval)
         self.times = output_times(self.t0, float(step.duration), self.dt_out)
         self.y0, self.yp0 = prob.initial(self.t0, state.X, state.V)
+        self.V_start = state.V
         self._ida_options()
         self.outputs = OutputRecord(prob, self.times)
         self.n_steps = self.n_restarts = 0
@@ -110,9 +113,11 @@ class _Run:
         step, prob, t0, y0 = self.step, self.prob, self.t0, self.y0
         self.linsolver = choose_solver(prob, step.linear_solver)
         self.omega = reference_frequency(prob, t0, y0)
-        atol = np.empty(2 * prob.n)
-        atol[0::2] = step.atol
-        atol[1::2] = step.atol * self.omega
+        jumps = velocity_jumps(self.model, self.V_start, t0, self.t_end)
+        self.resolve, self.resolve_choice = resolve_mode(
+            step.resolve, self.model.mass_model.carries_axial_waves, bool(jumps))
+        atol, self.omega_error = error_weights(self.resolve, step.atol, self.omega,
+                                               self.dt_out, prob.n)
         self.auto = step.max_order == "auto"
         self.order_choice = (OrderChoice(highest_frequency(prob, t0, y0), self.omega,
                                          self.t_end) if self.auto else None)
@@ -145,7 +150,9 @@ class _Run:
             "n_jacobian_evaluations": prob.n_jac,
             "n_rejected_states": prob.n_rejected,
             "wall_time": _time.perf_counter() - self.wall0, "rtol": step.rtol,
-            "atol": step.atol, "atol_velocity": step.atol * self.omega, "status": self.status,
+            "atol": step.atol, "atol_velocity": step.atol * self.omega_error,
+            "resolve": self.resolve, "resolve_choice": self.resolve_choice,
+            "error_frequency": self.omega_error, "status": self.status,
             "linear_solver": self.linsolver, "bandwidth": prob.bandwidth,
             "max_order": (oc.order if self.auto else int(step.max_order)),
             "max_order_setting": str(step.max_order),

@@ -150,10 +150,12 @@ def test_velocity_block_matches_finite_differences():
 # ------------------------------------------------------------------------------------------------
 # the tension envelope
 # ------------------------------------------------------------------------------------------------
-def _drop(ratio: float, *, M=1000.0, L0=10.0) -> str:
+def _drop(ratio: float, *, M=1000.0, L0=10.0, mass_model="lumped") -> str:
     """``scene_toml.falling_mass`` with the rope's mass ``ratio`` M: a mass M on a slack rope,
-    released from rest 0.5 m below the taut length, B 0.3 m aside."""
-    return falling_mass(ratio * M / L0, duration=1.0, M=M, L0=L0)
+    released from rest 0.5 m below the taut length, B 0.3 m aside; ``mass_model`` of the
+    step (the scene's is lumped)."""
+    text = falling_mass(ratio * M / L0, duration=1.0, M=M, L0=L0)
+    return text.replace('mass_model = "lumped"', f'mass_model = "{mass_model}"')
 
 
 def test_falling_mass_snap_from_the_envelope():
@@ -179,6 +181,22 @@ def test_falling_mass_snap_from_the_envelope():
     assert max(abs(e) for e in errors) < 5e-3, errors
 
 
+def test_auto_mass_model_carries_the_snap_of_a_mass_let_go():
+    """mass_model = "auto" on the falling mass: the step starts out of balance by the mass's
+    weight on a slack rope, so it can snap: auto takes the lumped mass, says why, and the
+    envelope gives the closed-form snap tension as with the lumped mass set by hand."""
+    M, L0, EA, x_off, fall = 1000.0, 10.0, 1e7, 0.3, 0.5
+    h = math.sqrt(L0**2 - x_off**2) - (L0 - fall)
+    Mg = M * G
+    exact = Mg + math.sqrt(Mg**2 + 2 * Mg * EA * h / L0)
+    ds = catdae.run(_drop(1e-3, mass_model="auto"))["drop"].to_dataset()
+    assert ds.attrs["mass_model"] == "lumped"
+    assert "can snap" in ds.attrs["mass_model_choice"]
+    assert "out of balance" in ds.attrs["note"] and "blended" in ds.attrs["note"]
+    assert ds.attrs["resolve"] == "waves"  # the error test follows the wave it carries
+    assert abs(float(ds.tension_max.max()) / exact - 1.0) < 5e-3
+
+
 def test_envelope_holds_every_output():
     """tension_max >= tension at every output, tension_min <= it, their times inside the step;
     for a free vibration the envelope is at least the outputs' extremes and close to them."""
@@ -196,9 +214,10 @@ def test_envelope_holds_every_output():
 
 
 def test_note_on_a_load_removed_from_a_slack_cable():
-    """A load taken off a slack cable acts suddenly: with the default (blended) mass the step's
-    note says the wave it sends is not fully carried, and names the load; with the lumped mass,
-    or on a taut cable, there is nothing to say."""
+    """A load taken off a slack cable acts suddenly: mass_model = "auto" takes the lumped mass,
+    which carries the wave it sends, and the note says why; with the blended mass set by hand
+    the note says the wave is not fully carried, and names the load; with the lumped mass set
+    by hand, or on a taut cable, there is nothing to say."""
     def case(length, mass_model):
         return cable_scene(
             B=(10.0, 0.0, 0.0), L0=length, EA=3.4e7, mass=5.0, elements=6, material="wire",
@@ -208,7 +227,12 @@ def test_note_on_a_load_removed_from_a_slack_cable():
                                                 mass_model=mass_model))
 
     ds = catdae.run(case(15.0, None))["let go"].to_dataset()
+    assert ds.attrs["mass_model"] == "lumped"
+    assert "'lift' added or removed" in ds.attrs["mass_model_choice"]
+    assert "'lift' added or removed" in ds.attrs["note"] and "auto" in ds.attrs["note"]
+    ds = catdae.run(case(15.0, "blended"))["let go"].to_dataset()
     assert ds.attrs["mass_model"] == "blended"
     assert "'lift' added or removed" in ds.attrs["note"] and "lumped" in ds.attrs["note"]
     assert catdae.run(case(15.0, "lumped"))["let go"].to_dataset().attrs["note"] == ""
-    assert catdae.run(case(9.99, None))["let go"].to_dataset().attrs["note"] == ""
+    taut = catdae.run(case(9.99, None))["let go"].to_dataset()
+    assert taut.attrs["note"] == "" and taut.attrs["mass_model"] == "blended"

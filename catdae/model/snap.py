@@ -1,0 +1,87 @@
+"""Can a transient snap? What ``mass_model = "auto"`` asks before it keeps a catenary mass
+(catdae.model.settings, docs/theory.md §18.5).
+
+A snap is an axial (water-hammer) wave: a sudden change of what holds an element that takes a
+change of chord by sag (Irvine's λ² > 1: slack, or sagging enough that it can go slack) sends
+a tension front along it, and the consistent catenary mass (and so the blended one) does not
+carry it there (docs/accuracy.md). The sudden changes are a start out of balance (a point mass
+or load added or removed at the start of the step, a mass let go) and a jump of a support
+velocity, at the start or at a breakpoint of the prescribed motion inside the step.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+SAG_LAMBDA2 = 1.0  # elements with λ² above this take a chord change by sag (the note's rule)
+SNAP_SHARE = 0.05  # a sudden change counts where the force it sends (m c Δv of a velocity
+#                    jump, the force of an item added or removed) reaches this share of the
+#                    largest tension at the start: a record's round-off steps or a small load
+#                    released to start a vibration do not
+
+
+def velocity_jumps(model, V: np.ndarray, t0: float, t1: float) -> list[tuple[float, float]]:
+    """(t, largest |Δv| m/s) of each jump of a prescribed support velocity in [t0, t1]: at t0
+    against the velocities ``V`` (n_nodes, 3) the step starts from, then at every breakpoint.
+    Differences at round-off level (1e-12 of the velocity) are not jumps."""
+    def jump(before: np.ndarray, after: np.ndarray) -> float:
+        dv = np.abs(after - before)
+        dv[dv <= 1e-12 * max(1.0, float(np.abs(after).max(initial=0.0)))] = 0.0
+        return float(dv.max(initial=0.0))
+
+    out = []
+    first = jump(np.asarray(V, float).reshape(-1)[model.fixed], model.support_values(t0)[1])
+    if first > 0.0:
+        out.append((t0, first))
+    for before, at in model.breakpoints(t0, t1):
+        dv = jump(model.support_values(before)[1], model.support_values(at)[1])
+        if dv > 0.0:
+            out.append((at, dv))
+    return out
+
+
+def unbalance(model, state, X: np.ndarray, t0: float) -> tuple[float, int]:
+    """(the largest out-of-balance force on a free node at t0, N; that node's index): what a
+    step that starts out of equilibrium (a load or mass added or removed, a mass let go)
+    releases at once."""
+    r = (model.internal_force(state, X) - model.nodal_load(t0)).reshape(-1, 3)
+    r[model.fixed_mask] = 0.0  # the supports take theirs as reactions
+    norms = np.linalg.norm(r, axis=1)
+    k = int(np.argmax(norms))
+    return float(norms[k]), k
+
+
+def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
+                h0: np.ndarray | None = None) -> str:
+    """Why the transient ``step`` starting from positions ``X`` and velocities ``V`` (n_nodes, 3)
+    at t0 can snap ("" if it cannot): a start out of balance (an item added or removed, a mass
+    let go) or a support velocity jump, whose force (the largest out-of-balance force on a
+    node; m c Δv of the jump's wave, c = sqrt(EA/m)) reaches ``SNAP_SHARE`` of the largest
+    tension, while elements take a chord change by sag (λ² > 1 at the start)."""
+    model.set_time(t0)
+    state = model.element_state(X, h0)
+    lam2 = model.element_lambda2(state, X)
+    sag = lam2 > SAG_LAMBDA2
+    if not sag.any():
+        return ""
+    worst = float(lam2.max())
+    where = (f"{int(sag.sum())} of {lam2.size} elements take a chord change by sag (λ² up to "
+             + ("inf, slack" if not np.isfinite(worst) else f"{worst:.3g}") + ", > 1)")
+    t_max = float(model.tensions(state).max(initial=0.0))
+    force, node = unbalance(model, state, X, t0)
+    if force >= SNAP_SHARE * t_max:
+        changed = [*step.add, *step.remove]
+        what = (f"{', '.join(repr(c) for c in changed)} added or removed" if changed else
+                "a release")
+        return (f"the step starts out of balance by {force:.3g} N at node "
+                f"{model.mesh.node_names[node]} ({what}; the largest tension is {t_max:.3g} N) "
+                f"while {where}")
+    mesh = model.mesh
+    impedance = float(np.sqrt(mesh.EA * mesh.m).max(initial=0.0))  # m c, N s/m
+    jumps = [j for j in velocity_jumps(model, V, t0, t0 + float(step.duration))
+             if impedance * j[1] >= SNAP_SHARE * t_max]
+    if jumps:
+        t, dv = jumps[0]
+        return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s while "
+                f"{where}")
+    return ""
