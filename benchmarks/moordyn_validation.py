@@ -15,7 +15,11 @@ the transient, kernels already compiled) per simulated second. MoorDyn (PyPI ``m
 input file as published (fileIC dropped: the file is not in the data set), driven as its test
 programs drive it, with its internal step dtM doubled from the input's value while the run
 stays stable (no error, no NaN); each stable step is reported with its error and cost.
-``--quick`` runs the 200 m chain (2 m heave) and jumper case 2 only.
+``--quick`` runs the 200 m chain (2 m heave) and jumper case 2 only. ``--long SECONDS`` runs each
+scene that long instead (the chain's heave continued as the sine its record samples, the jumper's
+motion or waves going on), catdae at the settings that passed and MoorDyn at its largest step
+within tolerance, for the cost per simulated second once start-up no longer counts; the error is
+still the published window's.
 """
 
 from __future__ import annotations
@@ -42,9 +46,9 @@ from moordyn_scenes import (  # noqa: E402
     WAVE_PERIOD,
     chain_metric,
     chain_toml,
+    heave_record,
     jumper_error,
     jumper_toml,
-    read_table,
 )
 
 import catdae  # noqa: E402
@@ -55,20 +59,21 @@ JUMPER_TOL = 1.5e3  # N
 
 
 # ---------------------------------------------------------------------------------- catdae
-def catdae_chain(depth, motion, elements, rtol):
-    text = chain_toml(depth, motion=motion, elements=elements, rtol=rtol)
+def catdae_chain(depth, motion, elements, rtol, duration=None):
+    text = chain_toml(depth, motion=motion, elements=elements, rtol=rtol, duration=duration)
     c0, w0 = time.process_time(), time.perf_counter()
     tree = catdae.run(load_case(text), progress=False)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    static = np.linalg.norm(tree["static"].to_dataset().reaction.sel(node="fairlead").values)
     ds = tree["heave"].to_dataset()
     t = np.linalg.norm(ds.reaction.sel(node="fairlead").values, axis=-1)
     dur = float(ds.time.values[-1] - ds.time.values[0])
-    return chain_metric(ds.time.values, t, depth, motion), cpu / dur, wall / dur, \
+    return chain_metric(ds.time.values, t, depth, motion, static), cpu / dur, wall / dur, \
         int(ds.attrs["n_steps"])
 
 
-def catdae_jumper(case, elements, rtol):
-    text = jumper_toml(case=case, elements=elements, rtol=rtol)
+def catdae_jumper(case, elements, rtol, duration=None):
+    text = jumper_toml(case=case, elements=elements, rtol=rtol, duration=duration)
     c0, w0 = time.process_time(), time.perf_counter()
     tree = catdae.run(load_case(text), progress=False)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
@@ -91,9 +96,12 @@ def _input(src: Path, folder: Path, dtm: float | None) -> Path:
     return out
 
 
-def moordyn_chain(md, depth, motion, dtm, folder):
+def moordyn_chain(md, depth, motion, dtm, folder, duration=None):
     src = DATA / "quasi_static_chain" / f"WD{depth:04d}_Chain.txt"
-    rec = read_table(DATA / "quasi_static_chain" / f"{motion}.txt")
+    t_rec, z_rec = heave_record(motion, duration)
+    keep = t_rec <= (t_rec[-1] if duration is None else duration) + 1e-9
+    rec = np.zeros((int(keep.sum()), 4))
+    rec[:, 0], rec[:, 3] = t_rec[keep], z_rec[keep]
     c0, w0 = time.process_time(), time.perf_counter()
     s = md.Create(str(_input(src, folder, dtm)))
     try:
@@ -119,7 +127,7 @@ def moordyn_chain(md, depth, motion, dtm, folder):
     return chain_metric(np.array(times), tens, depth, motion), cpu / dur, wall / dur
 
 
-def moordyn_jumper(md, case, dtm, folder):
+def moordyn_jumper(md, case, dtm, folder, duration=None):
     src = DATA / "lowe_and_langley_2006" / "line.txt"
     c0, w0 = time.process_time(), time.perf_counter()
     s = md.Create(str(_input(src, folder, dtm)))
@@ -132,7 +140,7 @@ def moordyn_jumper(md, case, dtm, folder):
         k = case - 1
         t, dt = 0.0, 0.005
         times, tens = [], []
-        while t < 80.0 + JUMPER_PERIOD:
+        while t < (80.0 + JUMPER_PERIOD if duration is None else duration) - 1e-9:
             f = min(t / JUMPER_PERIOD, 1.0)
             f = f**3 * (6 * f * f - 15 * f + 10)
             r = list(md.GetPointPos(point))
@@ -166,7 +174,7 @@ def _wave(A, T, phi, d, t, r):
     return u, a
 
 
-def moordyn_jumper_waves(md, case, dtm, folder):
+def moordyn_jumper_waves(md, case, dtm, folder, duration=None):
     src = DATA / "lowe_and_langley_2006" / "line.txt"
     phase, heading = WAVE_CASES[case]
     c0, w0 = time.process_time(), time.perf_counter()
@@ -180,7 +188,7 @@ def moordyn_jumper_waves(md, case, dtm, folder):
         n = md.GetLineN(line)
         t, dt = 0.0, 0.005
         times, tens = [], []
-        while t < 30.0 + 2 * WAVE_PERIOD:
+        while t < (30.0 + 2 * WAVE_PERIOD if duration is None else duration) - 1e-9:
             pts = np.array(md.ExternalWaveKinGetCoordinates(s)).reshape(-1, 3)
             u, a = _wave(5.0, WAVE_PERIOD, math.radians(phase), math.radians(heading),
                          t + 0.5 * dt, pts)
@@ -213,11 +221,44 @@ def moordyn_ladder(run, dtm0, n=4):
     return out
 
 
+# ---------------------------------------------------------------------------------- long runs
+def long_runs(md, seconds, quick=False):
+    """Each scene run for ``seconds`` of motion (the chain's heave continued as its sine, the
+    jumper's top motion or waves going on): catdae at the settings that passed on the short
+    runs, MoorDyn at its largest step within tolerance. Error on the published window."""
+    rows = []
+    chains = [(200, "ZZP1_A1")] if quick else [
+        (200, "ZZP1_A1"), (200, "ZZP1_A2"), (600, "ZZP1_A1"), (600, "ZZP1_A2")]
+    for depth, motion in chains:
+        scene = f"chain {depth} m, {motion}, {seconds:g} s"
+        for elements, rtol in ((20, 3e-3), (20, 1e-3)):
+            err, cpu, wall, steps = catdae_chain(depth, motion, elements, rtol, seconds)
+            rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err, CHAIN_TOL, cpu,
+                         wall, f"{steps} steps"))
+        with tempfile.TemporaryDirectory() as d:
+            err, cpu, wall = moordyn_chain(md, depth, motion, 0.003, Path(d), seconds)
+        rows.append((scene, "MoorDyn 76 segs, dtM 0.003 s", err, CHAIN_TOL, cpu, wall, "RK2"))
+    for case in ([2] if quick else [2, 3, 4, 5, 6]):
+        scene = f"jumper case {case}, {seconds:g} s"
+        for elements, rtol in ((20, 1e-4), (40, 1e-4)):
+            err, cpu, wall, steps = catdae_jumper(case, elements, rtol, seconds)
+            rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err / 1e3,
+                         JUMPER_TOL / 1e3, cpu, wall, f"{steps} steps"))
+        run = moordyn_jumper_waves if case in WAVE_CASES else moordyn_jumper
+        with tempfile.TemporaryDirectory() as d:
+            err, cpu, wall = run(md, case, 0.002, Path(d), seconds)
+        rows.append((scene, "MoorDyn 68 segs, EI, dtM 0.002 s", err / 1e3, JUMPER_TOL / 1e3,
+                     cpu, wall, "midpoint5"))
+    return rows
+
+
 # ---------------------------------------------------------------------------------- report
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--long", type=float, default=None,
+                    help="seconds of motion: run each scene this long instead (cost of long runs)")
     args = ap.parse_args(argv)
     import moordyn as md
     from transient_speed import machine
@@ -229,6 +270,9 @@ def main(argv=None):
     # warm the kernels (compiled once per source change; not part of any cost)
     catdae.run(load_case(chain_toml(200, motion="ZZP1_A1", elements=4, rtol=1e-2,
                                     duration=0.5)), progress=False)
+    if args.long is not None:
+        chains, jumpers = [], []
+        rows = long_runs(md, args.long, args.quick)
     for depth, motion in chains:
         scene = f"chain {depth} m, {motion}"
         for elements, rtol in ((10, 1e-3), (20, 3e-3), (20, 1e-3)):

