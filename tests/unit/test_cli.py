@@ -192,3 +192,21 @@ def test_the_summary_names_the_free_node_that_moves_most(tmp_path, capsys):
     expected = str(mag.sel(node=free).idxmax("node").values)
     assert float(mag.sel(node="A")) > float(mag.sel(node=expected))  # A moves most of all
     assert f"largest motion of a free node at {expected}: " in printed
+
+
+def test_a_run_under_a_profiler_ends_the_ordinary_way_and_keeps_its_profile(tmp_path):
+    """A finished ``catdae run`` skips the interpreter's teardown (catdae/__main__.py), except
+    under a profiler or tracer, which writes what it measured at the teardown: the profile of
+    ``python -m cProfile -o F -m catdae run`` exists and reads back, and the results are whole."""
+    import pstats
+
+    case = tmp_path / "c.toml"
+    case.write_text(cable_scene(B=(10.0, 0.0, 0.0), L0=10.5, EA=1e6, mass=1.0, elements=4,
+                                steps='[[steps]]\nkind = "static"\nname = "st"\n'))
+    prof, out = tmp_path / "run.prof", tmp_path / "c.nc"
+    proc = subprocess.run([sys.executable, "-m", "cProfile", "-o", str(prof), "-m", "catdae",
+                           "run", str(case), "-o", str(out), "--no-progress"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert pstats.Stats(str(prof)).total_calls > 0
+    assert catdae.read_results(out)["st"].position.notnull().all()
