@@ -111,6 +111,14 @@ class Ramp(TimeFunction):
     def _evaluate(self, t):
         d = self.duration
         a = self.amplitude
+        if isinstance(t, float):  # one time (every residual): Python floats, not numpy calls
+            xc = min(max((float(t) - self.start) / d, 0.0), 1.0)
+            if self.smooth:
+                return (a * xc**3 * (10.0 - 15.0 * xc + 6.0 * xc**2),
+                        a * 30.0 * xc**2 * (1.0 - xc) ** 2 / d,
+                        a * 60.0 * xc * (1.0 - xc) * (1.0 - 2.0 * xc) / d**2)
+            inside = self.start <= t < self.start + d
+            return a * xc, a / d if inside else 0.0, 0.0
         x = (t - self.start) / d
         # the corners by time, not by x: exactly at the breakpoints() times, so that the slope
         # is the one after the corner there and the one before it just below (x may round)
@@ -141,7 +149,8 @@ class Sine(TimeFunction):
     def _evaluate(self, t):
         w = 2.0 * math.pi * self.frequency
         arg = w * t + self.phase
-        s, c = np.sin(arg), np.cos(arg)
+        trig = math if isinstance(arg, float) else np  # one time: math, not numpy calls
+        s, c = trig.sin(arg), trig.cos(arg)
         a = self.amplitude
         return self.offset + a * s, a * w * c, -a * w * w * s
 
@@ -159,7 +168,8 @@ class Cosine(TimeFunction):
     def _evaluate(self, t):
         w = 2.0 * math.pi * self.frequency
         arg = w * t + self.phase
-        s, c = np.sin(arg), np.cos(arg)
+        trig = math if isinstance(arg, float) else np  # one time: math, not numpy calls
+        s, c = trig.sin(arg), trig.cos(arg)
         a = self.amplitude
         return self.offset + a * c, -a * w * s, -a * w * w * c
 
