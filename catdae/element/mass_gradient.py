@@ -13,10 +13,10 @@ from catdae.element.catenary import asinhc
 
 @njit(cache=True, inline="always")
 def _segment_grad(hx, hy, v, w, ea, a, b, f, fg):
-    """Add the flexibility of the load-free stretch [a, b] to f (6,) (as ``_segment``) and its
-    derivatives with respect to (hx, hy, v) to fg (6, 3).
+    """Add the flexibility of the load-free stretch [a, b] to f (6,) (as
+    ``catenary.segment``) and its derivatives with respect to (hx, hy, v) to fg (6, 3).
 
-    Forward-mode differentiation of ``_segment``, line by line, in real arithmetic: the
+    Forward-mode differentiation of ``catenary.segment``, line by line, in real arithmetic: the
     transcendental functions are evaluated once and shared by the three directions (the
     complex-step ``_mass_gradient_batch`` evaluates complex ones three times). Returns False
     where the tension vanishes.
