@@ -38,7 +38,10 @@ import catdae
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "tests"))  # the one scene builder (tests/scene_toml.py)
 from speed_accuracy import children_cost  # noqa: E402
+
+from scene_toml import block, cable, load, point_mass, scene, step, support_motion  # noqa: E402
 
 G = 9.81
 PEND_M, PEND_L0, PEND_EA, PEND_LINE = 1e5, 100.5, 1e9, 7.85398
@@ -51,41 +54,15 @@ def pendulum_case(step_extra: str = "", elements: int = 10, duration: float = 10
         tension = PEND_M * G / math.cos(th)
         th = math.asin(10.0 / (PEND_L0 * (1 + tension / PEND_EA)))
     hold = PEND_M * G * math.tan(th)
-    return f"""title = "pendulum (MoorDyn's test): 1e5 kg on a 100.5 m line"
-[materials.line]
-EA = {PEND_EA!r}
-mass = {PEND_LINE!r}
-weight = 0.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [0.0, 0.0, {-PEND_L0 * 1.001!r}]
-[supports]
-A = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "line"
-length = {PEND_L0!r}
-elements = {elements}
-[[point_masses]]
-name = "bob"
-node = "B"
-mass = {PEND_M!r}
-[[loads]]
-name = "hold"
-node = "B"
-force = [{hold!r}, 0.0, 0.0]
-[[steps]]
-kind = "static"
-name = "held"
-[[steps]]
-kind = "transient"
-name = "swing"
-remove = ["hold"]
-duration = {duration!r}
-output_interval = 0.05
-{step_extra}
-"""
+    return scene(
+        head={"title": "pendulum (MoorDyn's test): 1e5 kg on a 100.5 m line"},
+        materials={"line": {"EA": PEND_EA, "mass": PEND_LINE, "weight": 0.0}},
+        nodes={"A": [0.0, 0.0, 0.0], "B": [0.0, 0.0, -PEND_L0 * 1.001]}, supports=("A",),
+        cables=cable("c", material="line", length=PEND_L0, elements=elements),
+        extra=point_mass("bob", PEND_M, node="B") + load("hold", [hold, 0.0, 0.0], node="B"),
+        steps=step("static", "held") + step("transient", "swing", remove=["hold"],
+                                            duration=duration, output_interval=0.05)
+        + block(step_extra))
 
 
 def pendulum_figures(ds) -> dict:
@@ -159,45 +136,21 @@ def stay_case(step_extra: str = "", duration: float = 60.0, elements: int = 20,
     """The stay: a static step nudged out of plane, then the anchor A driven along the chord."""
     bx = STAY_L * math.cos(math.radians(STAY_INC))
     bz = STAY_L * math.sin(math.radians(STAY_INC))
-    rtol = "" if "rtol" in step_extra else "rtol = 1e-5\n"
-    motion = (f'{{ kind = "product", factors = [{{ kind = "sine", amplitude = {amplitude!r}, '
-              f'frequency = {frequency!r} }}, '
-              '{ kind = "ramp", duration = 2.0, smooth = true }] }')
-    return f"""title = "bridge stay driven at its deck anchor (parametric 2:1)"
-[materials.strand]
-EA = {STAY_EA!r}
-mass = {STAY_M!r}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [{bx!r}, 0.0, {bz!r}]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "stay"
-ends = ["A", "B"]
-material = "strand"
-elements = {elements}
-form = {{ pretension = {STAY_T!r} }}
-[[loads]]
-name = "nudge"
-node = "stay.{elements // 2}"
-force = [0.0, 2000.0, 0.0]
-[[support_motions]]
-node = "A"
-direction = [{bx!r}, 0.0, {bz!r}]
-value = {motion}
-[[steps]]
-kind = "static"
-name = "nudged"
-[[steps]]
-kind = "transient"
-name = "driven"
-remove = ["nudge"]
-duration = {duration!r}
-output_interval = 0.02
-{rtol}{step_extra}
-"""
+    rtol = None if "rtol" in step_extra else 1e-5
+    motion = {"kind": "product", "factors": [
+        {"kind": "sine", "amplitude": amplitude, "frequency": frequency},
+        {"kind": "ramp", "duration": 2.0, "smooth": True}]}
+    return scene(
+        head={"title": "bridge stay driven at its deck anchor (parametric 2:1)"},
+        materials={"strand": {"EA": STAY_EA, "mass": STAY_M}},
+        nodes={"A": [0.0, 0.0, 0.0], "B": [bx, 0.0, bz]},
+        cables=cable("stay", material="strand", elements=elements,
+                     form={"pretension": STAY_T}),
+        extra=load("nudge", [0.0, 2000.0, 0.0], node=f"stay.{elements // 2}")
+        + support_motion("A", direction=[bx, 0.0, bz], value=motion),
+        steps=step("static", "nudged") + step("transient", "driven", remove=["nudge"],
+                                              duration=duration, output_interval=0.02,
+                                              rtol=rtol) + block(step_extra))
 
 
 def stay_growth(ds, t_from: float = 5.0) -> float:

@@ -30,7 +30,8 @@ Scenes of several cables, or with other node names, are written by ``scene`` in 
 the arrays of tables are written by ``table`` (one ``key = value`` line per field given, in the
 order given, ``None`` left out) and its named forms ``cable``, ``point_mass``, ``load``,
 ``distributed_load``, ``support_motion``, ``spring``, ``damper``, ``bar`` and ``step``; a plain
-table (``[seabed]``, ``[ground]``, ...) by ``section``. Values (``value``): a bool as
+table (``[seabed]``, ``[ground]``, ...) by ``section``; lines written verbatim (with a closing
+newline) by ``block``. Values (``value``): a bool as
 ``true``/``false``, an integer as such, any other number as ``num`` writes it, a string quoted
 (``raw(...)`` as it stands), a sequence as an array and a mapping as an inline table.
 
@@ -49,7 +50,8 @@ def _float(x) -> str:
     return x if isinstance(x, str) else repr(float(x))
 
 
-def _block(text: str) -> str:
+def block(text: str) -> str:
+    """Lines written verbatim, with a closing newline when there are any."""
     return text if not text or text.endswith("\n") else text + "\n"
 
 
@@ -154,7 +156,7 @@ def scene(*, nodes: Mapping[str, Sequence], cables: str | Sequence[str],
               "[supports]"]
     lines += [s if "=" in s else f'{s} = "pinned"' for s in supports]
     blocks = cables if isinstance(cables, str) else "".join(cables)
-    return "\n" + "".join(line + "\n" for line in lines) + blocks + _block(extra) + _block(steps)
+    return "\n" + "".join(line + "\n" for line in lines) + blocks + block(extra) + block(steps)
 
 
 def cable_scene(*, B, L0, EA, mass, elements: int | None = None, A=(0.0, 0.0, 0.0),
@@ -200,7 +202,7 @@ def transient_step(name: str, duration, output_interval, *, rtol, atol, remove=N
     rm = "" if remove is None else "remove = [" + ", ".join(f'"{r}"' for r in remove) + "]\n"
     return (f'[[steps]]\nkind = "transient"\nname = "{name}"\n{rm}'
             f"duration = {num(duration)}\noutput_interval = {num(output_interval)}\n"
-            f"rtol = {num(rtol)}\natol = {num(atol)}\n" + _block(extra))
+            f"rtol = {num(rtol)}\natol = {num(atol)}\n" + block(extra))
 
 
 def long_transient(duration=1000.0) -> str:

@@ -30,7 +30,6 @@ from catdae.element.fluid_kinematics import (
     PROFILE,
     UNIFORM,
     point_kinematics,
-    surface_elevation,
 )
 
 _EMPTY = np.zeros(0)
@@ -137,14 +136,18 @@ def elevation(waves: Waves, g: float, depth: float, xy, times) -> np.ndarray:
     """The wave elevation above the still-water level (m), (n_times, n_points), at the points
     ``xy`` (n_points, 2) of the gravity frame's horizontal plane, as the Morison pass sees it
     (ramp included): for the water surface in the ParaView export."""
-    comps = wave_components(waves, g, depth)
+    amp, omega, wk, cosb, sinb, phase = wave_components(waves, g, depth)
     ramp = _wave_ramp(waves)
     xy = np.asarray(xy, float).reshape(-1, 2)
-    out = np.zeros((len(times), xy.shape[0]))
-    for k, t in enumerate(times):
-        r = 1.0 if ramp is None else float(ramp.evaluate(float(t))[0])
-        for p in range(xy.shape[0]):
-            out[k, p] = surface_elevation(xy[p, 0], xy[p, 1], float(t), *comps, r)[0]
+    t = np.asarray(times, float).reshape(-1)
+    # η = r(t) Σ_c a_c cos(k_c (x cos β_c + y sin β_c) - ω_c t + φ_c), every point of a time
+    # at once (surface_elevation's sum, point by point in the Morison pass)
+    space = np.outer(xy[:, 0], wk * cosb) + np.outer(xy[:, 1], wk * sinb) + phase  # (p, c)
+    out = np.empty((t.size, xy.shape[0]))
+    for k in range(t.size):
+        out[k] = np.cos(space - omega * t[k]) @ amp
+    if ramp is not None:
+        out *= ramp.evaluate(t)[0][:, None]
     return out
 
 

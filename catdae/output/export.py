@@ -126,16 +126,10 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str, case=None) 
     for k in range(times.size):
         at = ds.isel(time=k) if "time" in ds.dims else ds
         tens = at.tension.values  # (n_elem, 2) N
-        mesh = meshio.Mesh(
-            at.position.values,
-            cells,
-            point_data={v: at[v].values for v in point_vars},
-            cell_data={"tension": [tens.mean(axis=1)], "tension_i": [tens[:, 0]],
-                       "tension_j": [tens[:, 1]]},
-        )
         f = sub / f"{name}_{k:05d}.vtu"
-        with deferred():  # a signal waits until the file is complete
-            meshio.write(f, mesh, file_format="vtu")
+        _write(f, at.position.values, cells, point_data={v: at[v].values for v in point_vars},
+               cell_data={"tension": [tens.mean(axis=1)], "tension_i": [tens[:, 0]],
+                          "tension_j": [tens[:, 1]]})
         files.append(f)
     # part 0 the cables; parts 1, 2 the seabed and the water surface (one file, or one a time)
     parts = [files, *_environment(ds, sub, name, times, case)]
