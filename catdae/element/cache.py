@@ -40,8 +40,8 @@ _STAMP = "catdae-kernels.sha256"
 def load_lightly() -> bool:
     """Make numba load cached kernels without refreshing its compiler first (see above); True if
     installed. Left as it is (False) when numba's loader is not the one this was written for
-    (numba 0.59-0.68: ``Cache.load_overload`` refreshes, then calls ``_load_overload``). A
-    load that fails the light way is retried the ordinary way."""
+    (numba 0.68: ``Cache.load_overload`` refreshes, then calls ``_load_overload``; its names
+    are checked). A load that fails the light way is retried the ordinary way."""
     from numba.core import caching
     from numba.core.runtime import rtsys
 
