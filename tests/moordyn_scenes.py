@@ -63,10 +63,14 @@ def read_table(path: Path, sep: str | None = None) -> np.ndarray:
     return np.array(rows, float)
 
 
-def _damping(ratio: float | None) -> str:
+def _damping(ratio: float | None, rate: str = "strain") -> str:
     """MoorDyn's BA/-zeta: ζ of critical at each segment's axial frequency, catdae's
-    ``axial_damping`` stated at each element's own (docs/case-format.md)."""
-    return "" if not ratio else f"axial_damping = {{ ratio = {ratio!r} }}\n"
+    ``axial_damping`` stated at each element's own (docs/case-format.md), on the strain rate or
+    (``rate = "chord"``, as MoorDyn's straight segments have it) on the chord's rate."""
+    if not ratio:
+        return ""
+    on = "" if rate == "strain" else f', rate = "{rate}"'
+    return f"axial_damping = {{ ratio = {ratio!r}{on} }}\n"
 
 
 def _inline(t: np.ndarray, v: np.ndarray) -> str:
@@ -179,8 +183,8 @@ def jumper_motion(case: int, dt: float = 0.05, t_end: float | None = None):
 
 def jumper_toml(*, elements: int = 20, case: int | None = None, duration: float | None = None,
                 rtol: float = 1e-4, output_interval: float = 0.1, mass_model: str = "lumped",
-                max_order: str | int = "auto", axial_damping: float | None = JUMPER_ZETA
-                ) -> str:
+                max_order: str | int = "auto", axial_damping: float | None = JUMPER_ZETA,
+                damping_rate: str = "chord") -> str:
     text = f"""
 title = "Lowe & Langley (2006) flexible jumper"
 gravity = 9.807
@@ -227,7 +231,7 @@ rtol = {rtol!r}
 atol = {rtol!r}
 mass_model = "{mass_model}"
 max_order = {max_order if isinstance(max_order, int) else repr(max_order).replace("'", '"')}
-{_damping(axial_damping)}"""
+{_damping(axial_damping, damping_rate)}"""
     elif case is not None:
         dur = JUMPER_PERIOD + 80.0 if duration is None else duration
         t, u = jumper_motion(case, t_end=dur + 1.0)
@@ -244,7 +248,7 @@ rtol = {rtol!r}
 atol = {rtol!r}
 mass_model = "{mass_model}"
 max_order = {max_order if isinstance(max_order, int) else repr(max_order).replace("'", '"')}
-{_damping(axial_damping)}"""
+{_damping(axial_damping, damping_rate)}"""
     return text
 
 

@@ -28,13 +28,14 @@ CARRY = 1e-4  # largest relative change of an end force carried to first order
 
 @njit(cache=True)
 def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf,
-                     load_total, cd, g, out):
+                     load_total, cd, g, chord, out):
     """End tensions (n, 2) at the state y (positions and velocities of the unknowns in
     ``fidx``, interleaved; fixed dofs at ``xp``/``vp``) from the end forces ``hb`` and
     stiffnesses ``kb`` solved at positions ``xb``: h = hb + kb (c - c_b) where the change
     |kb (c - c_b)| is below ``CARRY`` |hb|, else the element is solved again (warm-started from
     hb). Plus the viscous tension cd ė, ė = g·ċ (cd all zero without axial damping; g taken
-    again where the element is solved again). Returns the number of elements solved, -1 if
+    again where the element is solved again; with ``chord`` g is the unit chord, taken again
+    for every element). Returns the number of elements solved, -1 if
     one cannot be."""
     X = xb.copy()
     V = np.zeros(xb.shape[0])
@@ -73,8 +74,13 @@ def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, l
             if status == NOT_CONVERGED:
                 return -1
             solved += 1
-            if cd[e] != 0.0:
+            if cd[e] != 0.0 and not chord:
                 element_g(i, j, X, h, k33, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], ge)
+        if chord and cd[e] != 0.0:
+            n2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2]
+            inv = 1.0 / np.sqrt(n2) if n2 > 0.0 else 0.0
+            for a in range(3):
+                ge[a] = c[a] * inv
         rate = 0.0
         for a in range(3):
             rate += ge[a] * (V[j + a] - V[i + a])
@@ -122,10 +128,11 @@ class TensionEnvelope:
         xp, vp, _ = prob._supports(t)
         ax = prob.axial
         cd, g = (ax.cd, ax.g) if ax is not None else (self._zero_cd, self._zero_g)
+        chord = ax is not None and ax.chord
         el = prob.model.elements
         solved = carried_tensions(y, prob._fidx, prob._fixed, xp, vp, prob._conn, prob._Xb,
                                   prob._hw, prob._kmat, el.L0, el.EA, el.w, el._ptr, el._ls,
-                                  el._lf, el._load_total, cd, g, self._out)
+                                  el._lf, el._load_total, cd, g, chord, self._out)
         if solved < 0:
             return None
         self.n_elements_solved += solved
