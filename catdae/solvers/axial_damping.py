@@ -73,21 +73,27 @@ def axial_rates(conn, X, V, h, kmat, l0, ea, w, ptr, ls, lf, g, edot):
 
 
 @njit(cache=True)
+def unit_chord(c, k, out):
+    """out[:] = the unit vector of c[k:k + 3] (zero for a zero chord)."""
+    n2 = c[k] * c[k] + c[k + 1] * c[k + 1] + c[k + 2] * c[k + 2]
+    inv = 1.0 / np.sqrt(n2) if n2 > 0.0 else 0.0
+    for a in range(3):
+        out[a] = c[k + a] * inv
+
+
+@njit(cache=True)
 def chord_rates(conn, X, V, g, edot):
     """g = ĉ (n, 3), the unit chord, and ė = ĉ·ċ (n,), the rate of change of the chord length,
     of every element at positions X, velocities V (full dofs)."""
+    c = np.empty(3)
     for e in range(conn.shape[0]):
         i = 3 * conn[e, 0]
         j = 3 * conn[e, 1]
-        n2 = 0.0
         for a in range(3):
-            d = X[j + a] - X[i + a]
-            g[e, a] = d
-            n2 += d * d
-        inv = 1.0 / np.sqrt(n2) if n2 > 0.0 else 0.0
+            c[a] = X[j + a] - X[i + a]
+        unit_chord(c, 0, g[e])
         rate = 0.0
         for a in range(3):
-            g[e, a] *= inv
             rate += g[e, a] * (V[j + a] - V[i + a])
         edot[e] = rate
 

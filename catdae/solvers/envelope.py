@@ -21,7 +21,7 @@ from numba import njit
 
 from catdae.element.catenary import NOT_CONVERGED, solve_one
 from catdae.element.catenary_batch import solve_batch
-from catdae.solvers.axial_damping import element_g
+from catdae.solvers.axial_damping import element_g, unit_chord
 
 CARRY = 1e-4  # largest relative change of an end force carried to first order
 
@@ -33,10 +33,8 @@ def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, l
     ``fidx``, interleaved; fixed dofs at ``xp``/``vp``) from the end forces ``hb`` and
     stiffnesses ``kb`` solved at positions ``xb``: h = hb + kb (c - c_b) where the change
     |kb (c - c_b)| is below ``CARRY`` |hb|, else the element is solved again (warm-started from
-    hb). Plus the viscous tension cd ė, ė = g·ċ (cd all zero without axial damping; g taken
-    again where the element is solved again; with ``chord`` g is the unit chord, taken again
-    for every element). Returns the number of elements solved, -1 if
-    one cannot be."""
+    hb). Plus the viscous tension cd ė, ė = g·ċ (cd zero without axial damping; g taken again
+    where solved again; ``chord``: the unit chord). Returns the elements solved (-1: one failed)."""
     X = xb.copy()
     V = np.zeros(xb.shape[0])
     for k in range(fidx.shape[0]):
@@ -77,10 +75,7 @@ def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, l
             if cd[e] != 0.0 and not chord:
                 element_g(i, j, X, h, k33, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], ge)
         if chord and cd[e] != 0.0:
-            n2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2]
-            inv = 1.0 / np.sqrt(n2) if n2 > 0.0 else 0.0
-            for a in range(3):
-                ge[a] = c[a] * inv
+            unit_chord(c, 0, ge)
         rate = 0.0
         for a in range(3):
             rate += ge[a] * (V[j + a] - V[i + a])
