@@ -154,10 +154,11 @@ def test_swing_is_not_damped():
     assert amps[1] == pytest.approx(amps[0], abs=5e-4)
 
 
-def test_velocity_block_matches_finite_differences():
+@pytest.mark.parametrize("rate", ["strain", "chord"])
+def test_velocity_block_matches_finite_differences(rate):
     """∂r_v/∂v of the iteration matrix (cj = 0 isolates the damping and velocity terms) equals
     central differences of the residual in the velocities, with the axial damping on a sagging
-    3-element cable (g is not the chord direction there)."""
+    3-element cable (g is not the chord direction there), on the strain or the chord rate."""
     from catdae.model.assembly import Model
     from catdae.model.mesh import build_mesh
     from catdae.solvers.residual import TransientProblem
@@ -165,7 +166,7 @@ def test_velocity_block_matches_finite_differences():
     text = cable_scene(
         B=(9.0, 1.0, -2.0), L0=10.0, EA=1e6, mass=2.0, elements=3, material="w",
         steps=step("transient", "t", mass_model="lumped", duration=1.0, output_interval=0.1,
-                   axial_damping={"ratio": 0.3, "frequency": 5.0}))
+                   axial_damping={"ratio": 0.3, "frequency": 5.0, "rate": rate}))
     case = catdae.load_case(text)
     mesh = build_mesh(case)
     model = Model(case, mesh, set(), mass_model="lumped")
