@@ -137,10 +137,21 @@ def test_static_fluid_velocity_is_the_current_profile_and_the_wind_law(upright):
     np.testing.assert_allclose(ds.fluid_velocity.values, want, rtol=1e-12, atol=1e-14)
 
 
-def test_rigid_seabed_in_a_current_at_its_height_is_refused_plainly():
-    # a frictionless rigid seabed cannot hold the drag on the line resting on it
-    text = water_scene(np.eye(3), rigid=True).replace("[[0.0, 0.0, 0.0], [0.6", "[[0.05, 0.0, "
-                                                                                "0.0], [0.6")
-    with pytest.raises(catdae.errors.ConvergenceError, match="rests on the rigid seabed in a "
-                       "current of 0.05 m/s"):
-        catdae.run(catdae.load_case(text), progress=False)
+@pytest.mark.parametrize("turn", TURNS)
+def test_rigid_seabed_in_a_current_at_its_height_is_refused_at_input(turn):
+    # a frictionless rigid seabed's exact grounded relations take no drag on the resting line:
+    # refused when the case is read, the current's speed at the seabed's height (along up)
+    text = water_scene(TURNS[turn], rigid=True)
+    catdae.load_case(text)  # zero at the bed: accepted
+    bottom = vec(TURNS[turn] @ np.array([0.05, 0.0, 0.0]))
+    text = _with_bottom(text, bottom)
+    with pytest.raises(catdae.errors.CaseError, match=r"water\.current: a current of 0\.05 m/s "
+                       r"at the height of the rigid \[seabed\] \(z = -50 m"):
+        catdae.load_case(text)
+
+
+def _with_bottom(text: str, bottom: list[float]) -> str:
+    """The scene with the current profile's bottom velocity replaced by ``bottom``."""
+    head, _, rest = text.partition("velocity = [[")
+    _, _, tail = rest.partition("], [")
+    return f"{head}velocity = [{bottom}, [{tail}"

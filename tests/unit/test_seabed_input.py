@@ -83,3 +83,52 @@ def test_a_seabed_above_an_anchor_along_a_gravity_vector(extra, tmp_path, capsys
                        extra=extra, steps=static_step("st"))
     invalid(text, "seabed.z", "lies above support 'A' (z = -20 m)", tmp_path, capsys,
             subprocess_check=False)
+
+
+def in_current(current, *, stiffness=None, drag: float = 1.2) -> str:
+    """The chain of ``scene`` in 20 m of water (the rigid seabed at the depth, or on contact
+    springs of ``stiffness``) in a ``current``, with a normal drag coefficient ``drag`` (no axial
+    drag)."""
+    bed = {} if stiffness is None else {"stiffness": stiffness}
+    return cable_scene(A=(0.0, 0.0, -20.0), B=(40.0, 0.0, -10.0), L0=60.0, EA=5e8, mass=80.0,
+                       elements=4,
+                       properties={"diameter": 0.1, "drag_normal": drag, "drag_axial": 0.0},
+                       extra=section("water", surface=0.0, depth=20.0, current=current)
+                       + section("seabed", **bed), steps=static_step("st"))
+
+
+PROFILE_AT_BED = {"z": [-20.0, 0.0], "velocity": [[0.3, 0.4, 0.0], [1.0, 0.0, 0.0]]}
+ZERO_AT_BED = {"z": [-20.0, 0.0], "velocity": [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]}
+
+
+TWICE = {"kind": "cosine", "amplitude": 2.0, "frequency": 0.5}  # 2 at t = 0
+
+
+@pytest.mark.parametrize("current, speed", [([0.0, 0.5, 0.0], "0.5"), (PROFILE_AT_BED, "0.5"),
+                                            ({**PROFILE_AT_BED, "time": TWICE}, "1")])
+def test_a_current_at_a_rigid_seabed_is_refused_at_input(current, speed, tmp_path, capsys):
+    # the exact grounded element takes no drag on the part resting on the rigid seabed: refused
+    # before any step runs, naming the current, its speed at the seabed and the way out
+    invalid(in_current(current), "water.current", f"a current of {speed} m/s at the height of "
+            "the rigid [seabed] (z = -20 m, no stiffness) on lines with drag (material m)",
+            tmp_path, capsys, subprocess_check=False)
+    err_text = "give [seabed] stiffness (Pa/m: contact springs), or a current profile that is "
+    invalid(in_current(current), "water.current", err_text, tmp_path, capsys,
+            subprocess_check=False)
+
+
+def test_the_ways_out_of_a_current_at_a_rigid_seabed_are_accepted():
+    import catdae
+
+    still = {**PROFILE_AT_BED, "time": {"kind": "sine", "amplitude": 2.0, "frequency": 0.5}}
+    for text in (in_current(ZERO_AT_BED), in_current([0.0, 0.5, 0.0], drag=0.0),
+                 in_current(still)):
+        catdae.load_case(text)  # no current at the bed (at t = 0), or nothing for it to drag
+    # contact springs: the chain rests on them and the anchor holds the drag across it
+    ds = catdae.run(catdae.load_case(in_current([0.0, 0.5, 0.0], stiffness=1.0e7)),
+                    progress=False)["st"].ds
+    assert float(ds.seabed_length.values[0]) > 10.0
+    drag = 0.5 * 1025.0 * 1.2 * 0.1 * 0.5**2  # N/m across a straight line at most
+    ry = float(ds.reaction.sel(node="A", axis="y") + ds.reaction.sel(node="B", axis="y"))
+    # the supports hold the drag across the nearly straight 60 m chain (-911.6 N measured)
+    assert -drag * 60.0 < ry < -0.95 * drag * 60.0
