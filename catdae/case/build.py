@@ -151,7 +151,6 @@ class Builder(CablesPass, ConnectorsPass, StepsPass, SweepPass, TimePass, FluidP
                              else water.surface - water.depth,
                              water_surface=None if water is None else water.surface)
         self.water_floor(water, nodes, supports, seabed)
-        self.rigid_bed_current(seabed, water, cables, materials)
         self.form_first_step(cables, steps, top.steps)
         self.slack(cables, materials, nodes, point_masses, loads, distributed)
         self.names(top)

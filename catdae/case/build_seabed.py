@@ -2,15 +2,13 @@
 
 Validated here (pass 2, pydantic) and checked against the scene (pass 3): the bottom must not
 lie above a support, contact stiffness and damping need the contact width (the materials'
-``diameter``), modal and transient steps need a finite ``stiffness``, and a rigid seabed takes
-no current at its height on lines with drag (:meth:`SeabedPass.rigid_bed_current`).
+``diameter``), and modal and transient steps need a finite ``stiffness``.
 """
 
 from __future__ import annotations
 
 from typing import Annotated, Any
 
-import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from catdae.case.messages import found_text, is_number
@@ -95,36 +93,6 @@ class SeabedPass:
         return Seabed(z=float(z), stiffness=sb.stiffness, damping=sb.damping,
                       friction_axial=axial, friction_lateral=lateral,
                       friction_velocity=sb.friction_velocity)
-
-    def rigid_bed_current(self, seabed: Seabed | None, water, cables: dict, materials: dict
-                          ) -> None:
-        """A rigid seabed (no ``stiffness``: static steps only, all at t = 0) under a current
-        that is not zero at its height, on cables whose material has drag: refused. The exact
-        grounded element carries the lying part straight along the seabed at a constant
-        horizontal tension: a drag along or across that part is outside it (lumped at the
-        nodes, the drag on the touchdown element's inclined chord pushes lying nodes off the
-        frictionless bed; docs/case-format.md, "Seabed")."""
-        if seabed is None or seabed.stiffness is not None or water is None:
-            return
-        cur = water.current
-        if cur is None:
-            return
-        vel = np.asarray(cur.velocity, float).reshape(-1, 3)
-        u = vel[0] if not cur.z else np.array([np.interp(seabed.z, cur.z, vel[:, a])
-                                               for a in range(3)])
-        if cur.time is not None:
-            u = u * float(cur.time.evaluate(0.0)[0])
-        speed = float(np.linalg.norm(u))
-        dragged = sorted({c.material for _, c in cables.values() if (m := materials.get(
-            c.material)) is not None and (m.drag_normal > 0.0 or m.drag_axial > 0.0)})
-        if speed == 0.0 or not dragged:
-            return
-        self.problem(("water", "current"), f"a current of {speed:.3g} m/s at the height of the "
-                     f"rigid [seabed] (z = {seabed.z:g} m, no stiffness) on lines with drag "
-                     f"(material {', '.join(dragged)}): its exact grounded relations hold the "
-                     "resting part straight at a constant tension and take no drag on it; give "
-                     "[seabed] stiffness (Pa/m: contact springs), or a current profile that is "
-                     "zero at the seabed's height")
 
     def height(self, p) -> float:
         """Height of a point along "up" (-gravity)."""
