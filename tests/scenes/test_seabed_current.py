@@ -14,11 +14,11 @@ import math
 
 import numpy as np
 import pytest
-from reference_current import grounded_line_in_current
 
 import catdae
 
 from reference import grounded_catenary
+from reference_current import grounded_line_in_current
 from scene_toml import cable, scene, section, step
 
 EA, MASS, D, RHO, G, CD, CDA = 1.674e9, 390.0, 0.252, 1025.0, 9.81, 1.37, 0.64
