@@ -129,6 +129,7 @@ def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, suppo
         pulling = contact & (rz < -1e-9 * fscale)
         if not below.any() and not pulling.any():
             _check_dips(gm, sol, zb, ztol)
+            _check_slack_resting(gm, sol, fscale)
             return sol, gm
         seen.add(contact.tobytes())
         contact = (contact | below) & ~pulling
@@ -216,6 +217,26 @@ def _check_dips(gm: GroundedModel, sol, zb: float, ztol: float) -> None:
             f"element {gm.mesh.element_names[int(bad[0])]} dips below the seabed between its "
             "nodes with both ends off it: use more elements on that cable, so that a node "
             "falls on the lying part")
+
+
+def _check_slack_resting(gm: GroundedModel, sol, fscale: float) -> None:
+    """In a current, a resting element without tension: the drag along the resting part has
+    taken its tension to zero before the anchor, and on a frictionless seabed the rest of it
+    has nothing to hold it (the line would pile up at the anchor): no equilibrium, say so."""
+    fl = gm.fluid
+    if fl is None or fl.water is None or fl.water.current is None:
+        return
+    resting = np.flatnonzero(gm.mode != g.FREE)
+    if resting.size == 0:
+        return
+    t = gm.tensions(sol.state)[resting].max(axis=1)
+    slack = resting[t <= 1e-9 * fscale]
+    if slack.size:
+        raise ConvergenceError(
+            f"element {gm.mesh.element_names[int(slack[0])]} rests slack on the rigid seabed: "
+            "the current's drag along the resting part takes its tension to zero before the "
+            "anchor, and a frictionless seabed holds nothing there (the line would pile up at "
+            "the anchor): no static equilibrium")
 
 
 def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str, np.ndarray]:

@@ -80,3 +80,14 @@ def test_currents_along_and_oblique_to_a_resting_chain(current, elements):
     e = errors(current, elements, ref)
     assert e["force"] < 1.2e-5, e
     assert e["lying"] < 5e-3 and e["touchdown"] < 5e-3, e
+
+
+def test_a_current_that_slackens_the_resting_part_is_said_plainly():
+    # 3 m/s towards the anchor: the axial drag on the resting part (2.3 kN/m over about 480 m)
+    # far exceeds the still-water anchor tension (300 kN), so the resting part's tension would
+    # reach zero before the anchor, which a frictionless seabed cannot hold
+    still = grounded_catenary(650.0, 200.0, LENGTH, EA, W)
+    f_axial = 0.5 * RHO * CDA * math.pi * D * 3.0**2
+    assert f_axial * still["lying_length"] > 3.0 * still["H"]
+    with pytest.raises(catdae.errors.ConvergenceError, match="rests slack on the rigid seabed"):
+        catdae.run(catdae.load_case(chain((3.0, 0.0, 0.0), 20)), progress=False)
