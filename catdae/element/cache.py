@@ -35,13 +35,16 @@ KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
                   "element/fluid_kinematics", "element/grounded", "solvers/axial_damping",
                   "solvers/envelope")
 _STAMP = "catdae-kernels.sha256"
+_OWN = str(Path(__file__).resolve().parents[1])  # the catdae package folder
 
 
 def load_lightly() -> bool:
     """Make numba load cached kernels without refreshing its compiler first (see above); True if
     installed. Left as it is (False) when numba's loader is not the one this was written for
     (numba 0.68: ``Cache.load_overload`` refreshes, then calls ``_load_overload``; its names
-    are checked). A load that fails the light way is retried the ordinary way."""
+    are checked). A load that fails the light way is retried the ordinary way. Only catdae's
+    own kernels (their cache under the package's folder) are loaded this way: any other numba
+    function in the process loads as numba loads it."""
     from numba.core import caching
     from numba.core.runtime import rtsys
 
@@ -54,6 +57,8 @@ def load_lightly() -> bool:
         return False
 
     def load_overload(self, sig, target_context):
+        if not str(getattr(self, "_cache_path", "")).startswith(_OWN):
+            return real(self, sig, target_context)  # not a catdae kernel: numba's own way
         try:
             rtsys.initialize(target_context)  # NRT: its symbols, once per process
             import numba.cpython.hashing  # noqa: F401  (its symbols)

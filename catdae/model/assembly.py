@@ -16,7 +16,6 @@ import scipy.sparse as sp
 from catdae.case import Case
 from catdae.case.timefunc import TimeFunction
 from catdae.element.elements import Elements, ElementState, PointLoads
-from catdae.model import brent
 from catdae.model.connectors import build_connectors, extend, with_connectors
 from catdae.model.fluid import Fluid
 from catdae.model.loading import (  # noqa: F401  (re-exported)
@@ -303,7 +302,10 @@ class Model(MassMatrices):
                     q[e, 0] = sv
                     return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
 
-                best = brent.minimum(neg, (lo, hi), xatol=1e-10 * mesh.L0[e])
+                from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
+
+                best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
+                                       options={"xatol": 1e-10 * mesh.L0[e]})
                 best_sag = max(best_sag, -float(best.fun))
             sag[ci] = best_sag
         unstrained = np.bincount(mesh.cable_of_element, weights=mesh.L0 / mesh.thermal,

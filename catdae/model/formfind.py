@@ -20,15 +20,15 @@ an augmented system would need ∂(element forces)/∂L0 and ∂(sag)/∂X from 
 does not provide. The cost is (n + 1) static solves per iteration for n form-found cables;
 Newton converges in a handful of iterations from the starting lengths below.
 
-Starting lengths, and bad targets: each cable alone, hanging between its end nodes under its own
-weight (at the first static step's temperature), is one exact catenary element; its q(L0) is
-scanned from 50 % strain to 100 times the chord and the first crossing of the target is refined
-(Brent's root finder, catdae.model.brent). This is the taut solution where two exist (the end
-tension first falls, then rises again as a cable gets longer). For a cable pinned at both ends
-with nothing on it the scan is the exact answer, and a target it never crosses cannot be
-reached: a ``CaseError`` naming the cable says why (also from ``catdae check``). For other
-cables the scan only gives the start; if Newton cannot reduce |r| any further the targets are
-reported as not reachable together, with the values reached.
+Starting lengths, and bad targets: each cable alone, hanging between its end nodes under its
+own weight (at the first static step's temperature), is one exact catenary element; its q(L0)
+is scanned from 50 % strain to 100 times the chord and the first crossing of the target is
+refined (brentq). This is the taut solution where two exist (the end tension first falls, then
+rises again as a cable gets longer). For a cable pinned at both ends with nothing on it the
+scan is the exact answer, and a target it never crosses cannot be reached: a ``CaseError``
+naming the cable says why (also from ``catdae check``). For other cables the scan only gives
+the start; if Newton cannot reduce |r| any further the targets are reported as not reachable
+together, with the values reached.
 """
 
 from __future__ import annotations
@@ -44,7 +44,6 @@ from catdae.case.frame import gravity_rotation
 from catdae.case.names import cable_of
 from catdae.element.elements import SLACK, Elements
 from catdae.errors import CaseError, ConvergenceError
-from catdae.model import brent
 
 TOL = 1e-9  # relative: |q - target| <= TOL |target|
 MAX_ITER = 40
@@ -144,7 +143,9 @@ def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
         if np.isfinite(d[k]) and np.isfinite(d[k + 1]) and d[k] * d[k + 1] <= 0.0:
             if d[k] == 0.0:
                 return float(ratios[k] * lc), ""
-            length = brent.root(lambda x: float(q_of(x)[0]) - target, ratios[k] * lc,
+            from scipy.optimize import brentq  # lazy: 0.5-1 s to import
+
+            length = brentq(lambda x: float(q_of(x)[0]) - target, ratios[k] * lc,
                             ratios[k + 1] * lc, xtol=1e-14 * lc, rtol=1e-14)
             return float(length), ""
     unit = _UNITS[kind]
