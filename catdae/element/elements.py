@@ -153,6 +153,9 @@ class Elements:
         return np.ascontiguousarray(s)
 
     def _h(self, h) -> np.ndarray:
+        if (type(h) is np.ndarray and h.shape == (self.n, 3) and h.dtype == np.float64
+                and h.flags.c_contiguous):  # the usual case (every output): as it is
+            return h
         return np.ascontiguousarray(np.broadcast_to(np.asarray(h, float), (self.n, 3)))
 
     def solve(self, chord, h0=None, *, tol: float = 1e-12, max_iter: int = 100) -> ElementState:
