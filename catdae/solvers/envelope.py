@@ -201,7 +201,6 @@ class TensionEnvelope:
             tension = self.tensions(t, y)
             if tension is None:
                 return
-        self._take(t, self._X, False,  # y unused: any 1-D float array
-                   
-                   np.ascontiguousarray(tension, float))
+        # y is unused without the carry: any 1-D float array
+        self._take(t, self._X, False, np.ascontiguousarray(tension, float))
         self.n_updates += 1
