@@ -276,3 +276,36 @@ def position_batch(h, w, ea, l0, mode, s, out):
         for j in range(s.shape[1]):
             _position_one(h[e, 0], h[e, 1], h[e, 2], w[e], ea[e], l0[e], mode[e], s[e, j],
                           out[e, j], f)
+
+
+# --------------------------------------------------------------------------------------------
+# The seabed's penalty contact at the nodes (catdae.model.seabed.SeabedContact; §17.5)
+@njit(cache=True)
+def contact_forces(X, V, nodes, nb_a, nb_b, area, zb, k, c, mu_a, mu_l, vs, use_v, out):
+    """Force of the seabed on each contact node below z_b, into ``out`` (n_nodes, 3), which
+    holds zeros there: N = a k δ up, -a c ż with the velocities, and the smoothed Coulomb
+    friction -N M u / sqrt(|u|² + v_s²), M = μ_a ê êᵀ + μ_l (I - ê êᵀ) on the horizontal
+    velocity u, ê the horizontal direction of the chord through the node's neighbours."""
+    friction = use_v and (mu_a > 0.0 or mu_l > 0.0)
+    for p in range(nodes.shape[0]):
+        i = nodes[p]
+        delta = zb - X[i, 2]
+        if delta <= 0.0:
+            continue
+        n = area[p] * k * delta
+        fz = n
+        if use_v:
+            fz -= area[p] * c * V[i, 2]
+        out[i, 2] = fz
+        if friction:
+            ux, uy = V[i, 0], V[i, 1]
+            ex = X[nb_b[p], 0] - X[nb_a[p], 0]
+            ey = X[nb_b[p], 1] - X[nb_a[p], 1]
+            en = np.sqrt(ex * ex + ey * ey)
+            if en > 0.0:
+                ex /= en
+                ey /= en
+            ua = ux * ex + uy * ey
+            g = n / np.sqrt(ux * ux + uy * uy + vs * vs)
+            out[i, 0] = -g * (mu_l * ux + (mu_a - mu_l) * ua * ex)
+            out[i, 1] = -g * (mu_l * uy + (mu_a - mu_l) * ua * ey)

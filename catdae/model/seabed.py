@@ -203,12 +203,12 @@ class SeabedContact:
     def __init__(self, seabed, mesh, free_z: np.ndarray, area: np.ndarray,
                  stiffness: float | None = None):
         """``free_z`` (n_nodes,) bool: nodes whose z is free; ``area`` (n_nodes,) m²."""
-        self.zb = seabed.z
-        self.k = seabed.stiffness if stiffness is None else stiffness
-        self.c = seabed.damping if stiffness is None else 0.0
-        self.mu_a = seabed.friction_axial if stiffness is None else 0.0
-        self.mu_l = seabed.friction_lateral if stiffness is None else 0.0
-        self.vs = seabed.friction_velocity
+        self.zb = float(seabed.z)
+        self.k = float(seabed.stiffness if stiffness is None else stiffness)
+        self.c = float(seabed.damping) if stiffness is None else 0.0
+        self.mu_a = float(seabed.friction_axial) if stiffness is None else 0.0
+        self.mu_l = float(seabed.friction_lateral) if stiffness is None else 0.0
+        self.vs = float(seabed.friction_velocity)
         self.nodes = np.flatnonzero(free_z & (area > 0))  # (p,)
         self.area = area[self.nodes]
         self.friction = self.mu_a > 0 or self.mu_l > 0
@@ -261,24 +261,12 @@ class SeabedContact:
         return d / np.where(n > 0, n, 1.0)[:, None]
 
     def forces(self, X: np.ndarray, V: np.ndarray | None = None):
-        """Force of the seabed on the nodes, (n_nodes, 3) N, and the contact data for the
-        derivatives: (in contact mask (p,), N (p,), friction factor pieces)."""
-        z = X[self.nodes, 2]
-        delta = self.zb - z
-        on = delta > 0.0
+        """Force of the seabed on the nodes, (n_nodes, 3) N (one compiled pass,
+        ``grounded.contact_forces``)."""
         out = np.zeros_like(X)
-        n_force = np.where(on, self.area * self.k * delta, 0.0)  # (p,) N
-        fz = n_force.copy()
-        if V is not None and self.c:
-            fz -= np.where(on, self.area * self.c * V[self.nodes, 2], 0.0)
-        out[self.nodes, 2] = fz
-        if V is not None and self.friction and on.any():
-            u = V[self.nodes, :2]
-            e = self._direction(X)
-            ua = np.einsum("pi,pi->p", u, e)
-            mu_u = self.mu_l * u + (self.mu_a - self.mu_l) * ua[:, None] * e  # M u
-            s = np.sqrt(np.einsum("pi,pi->p", u, u) + self.vs * self.vs)
-            out[self.nodes, :2] = -(n_force / s)[:, None] * mu_u
+        g.contact_forces(X, X if V is None else V, self.nodes, self.nb_a, self.nb_b, self.area,
+                         self.zb, self.k, self.c, self.mu_a, self.mu_l, self.vs, V is not None,
+                         out)
         return out
 
     def derivatives(self, X: np.ndarray, V: np.ndarray | None = None):
