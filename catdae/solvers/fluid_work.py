@@ -26,13 +26,14 @@ class FluidWork:
         V, A = prob.full_vectors(t, y[1::2], yp[1::2])
         X = prob.X.copy()
         X[prob.fidx] = y[0::2]
-        X[prob.model.fixed] = prob.model.support_positions(t)
+        X[prob.model.fixed] = prob._supports(t)[0]
         out = self.fluid.evaluate(t, X, V, A)[0]  # M_a A - f
         return -float(out @ V)
 
-    def at(self, t: float, y: np.ndarray, yp: np.ndarray) -> float:
-        """W at t >= self.t (trapezoid from the last step's end)."""
-        p = self.power(t, y, yp)
+    def at(self, t: float, y: np.ndarray, yp: np.ndarray, power: float | None = None) -> float:
+        """W at t >= self.t (trapezoid from the last step's end); ``power`` P at (t, y, yp)
+        if the caller has it (an output: the residual pass there left the fluid's forces)."""
+        p = self.power(t, y, yp) if power is None else power
         if self.t is None:
             return 0.0
         return self.W + 0.5 * (self.P + p) * (t - self.t)
