@@ -300,15 +300,13 @@ class SeabedContact:
     def energy(self, X: np.ndarray) -> float:
         """Elastic energy of the contact springs, Σ ½ a k δ², J."""
         delta = np.maximum(self.zb - X[self.nodes, 2], 0.0)
-        return float(0.5 * np.sum(self.area * self.k * delta * delta))
+        return 0.5 * self.k * float(self.area @ (delta * delta))
 
     def dissipation(self, X: np.ndarray, V: np.ndarray) -> float:
-        """Power taken out of the motion by the seabed's damping and friction, W (>= 0)."""
-        f = self.forces(X, V)
-        fel = np.zeros_like(X)
-        delta = self.zb - X[self.nodes, 2]
-        fel[self.nodes, 2] = np.where(delta > 0, self.area * self.k * delta, 0.0)
-        return float(-np.sum((f - fel) * V))
+        """Power taken out of the motion by the seabed's damping and friction, W (>= 0): minus
+        the power of the contact forces less that of the springs (a k δ on ż)."""
+        elastic = self.k * np.maximum(self.zb - X[self.nodes, 2], 0.0) * self.area
+        return float(elastic @ V[self.nodes, 2]) - float(np.vdot(self.forces(X, V), V))
 
     def block_slots(self, pattern) -> np.ndarray:
         """Positions in the CSR data of ``pattern`` of the 3×3 block of every contact node,
