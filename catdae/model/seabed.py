@@ -211,7 +211,6 @@ class SeabedContact:
         self.vs = float(seabed.friction_velocity)
         self.nodes = np.flatnonzero(free_z & (area > 0))  # (p,)
         self.area = area[self.nodes]
-        self.friction = self.mu_a > 0 or self.mu_l > 0
         # neighbours for the line direction: the other ends of the node's elements
         conn = mesh.conn
         nbr = np.full((mesh.n_nodes, 2), -1, np.int64)
@@ -251,14 +250,9 @@ class SeabedContact:
         -∂f/∂q and -∂f/∂v added (copies)."""
         kq, kv = self.derivatives(X.reshape(-1, 3), V.reshape(-1, 3))
         kdata, vdata = kdata.copy(), vdata.copy()
-        np.add.at(kdata, self.slots, kq.ravel())
-        np.add.at(vdata, self.slots, kv.ravel())
+        kdata[self.slots] += kq.ravel()  # the nodes' own blocks: no slot twice
+        vdata[self.slots] += kv.ravel()
         return kdata, vdata
-
-    def _direction(self, X):
-        d = X[self.nb_b, :2] - X[self.nb_a, :2]
-        n = np.hypot(d[:, 0], d[:, 1])
-        return d / np.where(n > 0, n, 1.0)[:, None]
 
     def forces(self, X: np.ndarray, V: np.ndarray | None = None):
         """Force of the seabed on the nodes, (n_nodes, 3) N (one compiled pass,
@@ -270,31 +264,15 @@ class SeabedContact:
         return out
 
     def derivatives(self, X: np.ndarray, V: np.ndarray | None = None):
-        """-∂F/∂q and -∂F/∂v as (p, 3, 3) blocks at the contact nodes (the residual holds -F).
-        The line direction ê is held fixed (its derivative is left out of the iteration
-        matrix, which only has to be good)."""
+        """-∂F/∂q and -∂F/∂v as (p, 3, 3) blocks at the contact nodes (the residual holds -F;
+        one compiled pass, ``grounded.contact_derivatives``). The line direction ê is held
+        fixed (its derivative is left out of the iteration matrix, which only has to be good)."""
         p = self.nodes.size
         kq = np.zeros((p, 3, 3))
         kv = np.zeros((p, 3, 3))
-        delta = self.zb - X[self.nodes, 2]
-        on = delta > 0.0
-        ak = np.where(on, self.area * self.k, 0.0)
-        kq[:, 2, 2] = ak  # F_z = a k (z_b - z): -∂F_z/∂z = a k
-        if V is not None and self.c:
-            kv[:, 2, 2] = np.where(on, self.area * self.c, 0.0)
-        if V is not None and self.friction and on.any():
-            u = V[self.nodes, :2]
-            e = self._direction(X)
-            ua = np.einsum("pi,pi->p", u, e)
-            mu_u = self.mu_l * u + (self.mu_a - self.mu_l) * ua[:, None] * e
-            s = np.sqrt(np.einsum("pi,pi->p", u, u) + self.vs * self.vs)
-            n_force = ak * delta
-            # F_h = -N M u / s, N = a k δ: -∂F_h/∂z = -a k M u / s
-            kq[:, :2, 2] = -(ak / s)[:, None] * mu_u
-            mm = (self.mu_l * np.eye(2)[None]
-                  + (self.mu_a - self.mu_l) * e[:, :, None] * e[:, None, :])  # (p, 2, 2)
-            kv[:, :2, :2] = (n_force / s)[:, None, None] * (
-                mm - mu_u[:, :, None] * u[:, None, :] / (s * s)[:, None, None])
+        g.contact_derivatives(X, X if V is None else V, self.nodes, self.nb_a, self.nb_b,
+                              self.area, self.zb, self.k, self.c, self.mu_a, self.mu_l, self.vs,
+                              V is not None, kq, kv)
         return kq, kv
 
     def energy(self, X: np.ndarray) -> float:
