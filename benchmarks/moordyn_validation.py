@@ -21,7 +21,8 @@ motion or waves going on), catdae at the settings that passed and MoorDyn at its
 within tolerance, for the cost per simulated second once start-up no longer counts; the error is
 still the published window's. For the chain the note also gives the marginal cost, (cost of the
 long run - cost of the published 30 s) / (SECONDS - 30 s), each code's start-up taken out.
-``--scenes chain`` or ``--scenes jumper`` runs only those scenes (default: both).
+``--scenes chain`` or ``--scenes jumper`` runs only those scenes (default: both); ``--repeat N``
+gives the long chain runs' median cost of N runs of each code (the machine's load varies).
 """
 
 from __future__ import annotations
@@ -233,7 +234,7 @@ def moordyn_ladder(run, dtm0, n=4):
 
 
 # ---------------------------------------------------------------------------------- long runs
-def long_runs(md, seconds, quick=False, scenes=("chain", "jumper")):
+def long_runs(md, seconds, quick=False, scenes=("chain", "jumper"), repeat=1):
     """Each scene run for ``seconds`` of motion (the chain's heave continued as its sine, the
     jumper's top motion or waves going on): catdae at the settings that passed on the short
     runs, MoorDyn at its largest step within tolerance. Error on the published window."""
@@ -243,17 +244,24 @@ def long_runs(md, seconds, quick=False, scenes=("chain", "jumper")):
     for depth, motion in (chains if "chain" in scenes else []):
         scene = f"chain {depth} m, {motion}, {seconds:g} s"
         for elements, rtol in CHAIN_LONG:
-            err, cpu, wall, steps = catdae_chain(depth, motion, elements, rtol, seconds)
-            short = catdae_chain(depth, motion, elements, rtol)[1]
+            runs = [catdae_chain(depth, motion, elements, rtol, seconds) for _ in range(repeat)]
+            err, steps = runs[0][0], runs[0][3]
+            cpu, wall = (float(np.median([r[k] for r in runs])) for k in (1, 2))
+            short = np.median([catdae_chain(depth, motion, elements, rtol)[1]
+                               for _ in range(repeat)])
             rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err, CHAIN_TOL, cpu,
                          wall, f"{steps} steps; marginal "
                          f"{_marginal(cpu, seconds, short):.4g}"))
-        with tempfile.TemporaryDirectory() as d:
-            err, cpu, wall = moordyn_chain(md, depth, motion, 0.003, Path(d), seconds)
-        with tempfile.TemporaryDirectory() as d:
-            short = moordyn_chain(md, depth, motion, 0.003, Path(d), RECORD)[1]
+        runs, shorts = [], []
+        for _ in range(repeat):
+            with tempfile.TemporaryDirectory() as d:
+                runs.append(moordyn_chain(md, depth, motion, 0.003, Path(d), seconds))
+            with tempfile.TemporaryDirectory() as d:
+                shorts.append(moordyn_chain(md, depth, motion, 0.003, Path(d), RECORD)[1])
+        err = runs[0][0]
+        cpu, wall = (float(np.median([r[k] for r in runs])) for k in (1, 2))
         rows.append((scene, "MoorDyn 76 segs, dtM 0.003 s", err, CHAIN_TOL, cpu, wall,
-                     f"RK2; marginal {_marginal(cpu, seconds, short):.4g}"))
+                     f"RK2; marginal {_marginal(cpu, seconds, np.median(shorts)):.4g}"))
     for case in ([] if "jumper" not in scenes else [2] if quick else [2, 3, 4, 5, 6]):
         scene = f"jumper case {case}, {seconds:g} s"
         for elements, rtol in ((20, 1e-4), (40, 1e-4)):
@@ -277,6 +285,8 @@ def main(argv=None):
                     help="seconds of motion: run each scene this long instead (cost of long runs)")
     ap.add_argument("--scenes", default="chain,jumper",
                     help="which scenes: chain, jumper or both (comma-separated)")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="long chain runs: median cost of this many runs of each code")
     args = ap.parse_args(argv)
     scenes = tuple(x.strip() for x in args.scenes.split(","))
     if not set(scenes) <= {"chain", "jumper"}:
@@ -295,7 +305,7 @@ def main(argv=None):
                                     duration=0.5)), progress=False)
     if args.long is not None:
         chains, jumpers = [], []
-        rows = long_runs(md, args.long, args.quick, scenes)
+        rows = long_runs(md, args.long, args.quick, scenes, args.repeat)
     for depth, motion in chains:
         scene = f"chain {depth} m, {motion}"
         for elements, rtol in CHAIN_SHORT:
