@@ -1,0 +1,140 @@
+"""catdae against MoorDyn on issue 25's scenes, whole processes on both sides, at equal accuracy.
+
+The pendulum (MoorDyn's own test: 1e5 kg on a 100.5 m line, EA 1e9, held 10 m aside, about
+5.3 periods) and the violent example 2 (50 elements, 4 s). Each run is a new Python process:
+``python -m catdae run`` for catdae, and for MoorDyn (PyPI ``moordyn``) a process that imports
+it and runs benchmarks/moordyn_compare.py's driver of the same scene (its test file, RK4). The
+cost is the CPU time (user + system) of the child process, and its wall time; medians of
+``--repeats``. Accuracy: the pendulum's period against 2π sqrt(l/g) (1 + θ²/16) and its
+amplitude over the fifth period against the release offset (benchmarks/ringing.py); the violent
+scene's peak tension against the time-converged 264 kN.
+
+The ratio compares the cheapest catdae run that is at least as accurate as MoorDyn's run on
+both figures (pendulum) with that MoorDyn run.
+
+    python benchmarks/moordyn_parity.py [pendulum] [violent] [--repeats 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+import ringing  # noqa: E402
+from speed_accuracy import children_cost  # noqa: E402
+from static_speed import machine  # noqa: E402
+
+PEAK_REF = 264.0e3  # N, time-converged peak of the violent scene (catdae and OpenSees agree)
+
+CATDAE_PENDULUM = {
+    "rtol 1e-3, atol 1e-5": "rtol = 1e-3\natol = 1e-5",
+    "rtol 3e-4, atol 3e-6": "rtol = 3e-4\natol = 3e-6",
+    "rtol 2e-4, atol 2e-6": "rtol = 2e-4\natol = 2e-6",
+    "rtol 1e-4, atol 1e-6": "rtol = 1e-4\natol = 1e-6",
+}
+MOORDYN_PENDULUM = {  # label: (segments, BA/-zeta as a positive ratio)
+    "10 segments, BA/-zeta -0.01 (its test file)": (10, 0.01),
+    "10 segments, no internal damping": (10, 0.0),
+}
+CATDAE_VIOLENT = {
+    "rtol 5e-3, atol 1e-4, max_order 2 (README snap settings)": (
+        "max_order = 2", ["--rtol", "5e-3", "--atol", "1e-4"]),
+}
+MOORDYN_VIOLENT = {"50 segments, cfl 0.5, coupling 1e-4 s": (0.5, 1e-4)}
+
+
+def moordyn_process(call: str) -> tuple[dict, float, float]:
+    """MoorDyn in a new process: (the driver's figures, wall s, CPU s of the process)."""
+    code = (f"import sys, json; sys.path.insert(0, {str(HERE)!r}); import moordyn_compare as m; "
+            f"print('@@' + json.dumps(m.{call}))")
+    p, wall, cpu = children_cost(subprocess.run, [sys.executable, "-c", code],
+                                 capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(p.stderr[-2000:])
+    line = next(x for x in p.stdout.splitlines()[::-1] if x.startswith("@@"))
+    return json.loads(line[2:]), wall, cpu
+
+
+def median_runs(fn, repeats: int):
+    runs = [fn() for _ in range(repeats)]
+    return (runs[0][0], statistics.median(r[1] for r in runs),
+            statistics.median(r[2] for r in runs))
+
+
+def pendulum(folder: Path, repeats: int) -> list[str]:
+    rows, cat, md = [], [], []
+    for label, extra in CATDAE_PENDULUM.items():
+        text = ringing.pendulum_case(extra)
+        ds, wall, cpu = median_runs(lambda t=text: ringing.run_case(t, folder, "pend"), repeats)
+        f = ringing.pendulum_figures(ds)
+        cat.append((label, f, wall, cpu, int(ds.attrs.get("n_steps", 0))))
+    for label, (seg, zeta) in MOORDYN_PENDULUM.items():
+        f, wall, cpu = median_runs(lambda s=seg, z=zeta: moordyn_process(f"pendulum({s}, {z})"),
+                                   repeats)
+        md.append((label, f, wall, cpu))
+    rows.append("| pendulum run | period error | amplitude error | wall s | CPU s |")
+    rows.append("|---|---|---|---|---|")
+    for label, f, wall, cpu, steps in cat:
+        rows.append(f"| catdae {label} ({steps} steps) | {100 * f['period_err']:+.3f} % | "
+                    f"{100 * f['amp_err']:+.3f} % | {wall:.2f} | {cpu:.2f} |")
+    for label, f, wall, cpu in md:
+        rows.append(f"| MoorDyn {label} | {100 * f['period_err']:+.3f} % | "
+                    f"{100 * f['amp_err']:+.3f} % | {wall:.2f} | {cpu:.2f} |")
+    rows.append("")
+    for label, f, wall, cpu in md:
+        ok = [c for c in cat if abs(c[1]["period_err"]) <= abs(f["period_err"])
+              and abs(c[1]["amp_err"]) <= abs(f["amp_err"])]
+        if not ok:
+            rows.append(f"- against MoorDyn {label}: no catdae run as accurate")
+            continue
+        best = min(ok, key=lambda c: c[3])
+        rows.append(f"- against MoorDyn {label}: cheapest catdae run as accurate on both "
+                    f"figures is {best[0]}: ratio catdae/MoorDyn **{best[2] / wall:.2f} wall, "
+                    f"{best[3] / cpu:.2f} CPU**")
+    return rows
+
+
+def violent(folder: Path, repeats: int) -> list[str]:
+    rows = ["| violent run (50 elements, 4 s) | peak tension | error | wall s | CPU s |",
+            "|---|---|---|---|---|"]
+    for label, (extra, args) in CATDAE_VIOLENT.items():
+        text = ringing.violent_case(extra)
+        ds, wall, cpu = median_runs(
+            lambda t=text, a=args: ringing.run_case(t, folder, "violent", "--elements", "50", *a),
+            repeats)
+        peak = float(ds.tension_max.max())
+        rows.append(f"| catdae {label} | {peak / 1e3:.1f} kN | {100 * (peak / PEAK_REF - 1):+.2f} %"
+                    f" | {wall:.2f} | {cpu:.2f} |")
+    for label, (cfl, dt_c) in MOORDYN_VIOLENT.items():
+        f, wall, cpu = median_runs(
+            lambda c=cfl, d=dt_c: moordyn_process(f"violent(50, 4.0, {c}, {d})"), repeats)
+        rows.append(f"| MoorDyn {label} | {f['peak'] / 1e3:.1f} kN | "
+                    f"{100 * (f['peak'] / PEAK_REF - 1):+.2f} % | {wall:.2f} | {cpu:.2f} |")
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scenes", nargs="*", default=["pendulum", "violent"])
+    ap.add_argument("--repeats", type=int, default=3)
+    args = ap.parse_args()
+    print(f"Machine: {machine()}; load {os.getloadavg()[0]:.2f} at the start", flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        if "pendulum" in args.scenes:
+            print("\n".join(pendulum(Path(tmp), args.repeats)), flush=True)
+        if "violent" in args.scenes:
+            print("\n".join(violent(Path(tmp), args.repeats)), flush=True)
+    print(f"load {os.getloadavg()[0]:.2f} at the end")
+
+
+if __name__ == "__main__":
+    main()
