@@ -15,7 +15,8 @@ the transient, kernels already compiled) per simulated second. MoorDyn (PyPI ``m
 input file as published (fileIC dropped: the file is not in the data set), driven as its test
 programs drive it, with its internal step dtM doubled from the input's value while the run
 stays stable (no error, no NaN); each stable step is reported with its error and cost.
-``--quick`` runs the 200 m chain (2 m heave) and jumper case 2 only. ``--long SECONDS`` runs each
+``--quick`` runs the 200 m chain (2 m heave) and jumper case 2 only; ``--jumper`` the jumper's
+scenes only (each also by MoorDyn with EI = 0, the line catdae models). ``--long SECONDS`` runs each
 scene that long instead (the chain's heave continued as the sine its record samples, the jumper's
 motion or waves going on), catdae at the settings that passed and MoorDyn at its largest step
 within tolerance, for the cost per simulated second once start-up no longer counts; the error is
@@ -63,6 +64,9 @@ CHAIN_TOL = 0.15
 CHAIN_SHORT = ((10, 1e-3), (20, 1e-2), (20, 6e-3), (20, 3e-3), (20, 1e-3))
 CHAIN_LONG = ((20, 1e-2), (20, 6e-3), (20, 3e-3))
 JUMPER_TOL = 1.5e3  # N
+# catdae's jumper settings: the short runs' ladder, and the long runs' (those that passed)
+JUMPER_LADDER = ((20, 1e-4), (20, 3e-5), (40, 1e-4), (40, 3e-5))
+JUMPER_LONG = ((20, 1e-4), (40, 3e-5))
 
 
 # ---------------------------------------------------------------------------------- catdae
@@ -139,10 +143,23 @@ def moordyn_chain(md, depth, motion, dtm, folder, duration=None):
     return chain_metric(np.array(times), tens, depth, motion), cpu / dur, wall / dur
 
 
-def moordyn_jumper(md, case, dtm, folder, duration=None):
-    src = DATA / "lowe_and_langley_2006" / "line.txt"
+def _jumper_input(folder: Path, dtm: float | None, ei: float | None) -> Path:
+    """The jumper's line.txt (``_input``), its EI replaced by ``ei`` when given."""
+    path = _input(DATA / "lowe_and_langley_2006" / "line.txt", folder, dtm)
+    if ei is not None:
+        lines = path.read_text().splitlines()
+        for k, ln in enumerate(lines):
+            cols = ln.split()
+            if cols and cols[0] == "main" and len(cols) == 10:
+                cols[5] = repr(float(ei))
+                lines[k] = "  ".join(cols)
+        path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def moordyn_jumper(md, case, dtm, folder, duration=None, ei=None):
     c0, w0 = time.process_time(), time.perf_counter()
-    s = md.Create(str(_input(src, folder, dtm)))
+    s = md.Create(str(_jumper_input(folder, dtm, ei)))
     try:
         point = md.GetPoint(s, 2)
         line = md.GetLine(s, 1)
@@ -186,11 +203,10 @@ def _wave(A, T, phi, d, t, r):
     return u, a
 
 
-def moordyn_jumper_waves(md, case, dtm, folder, duration=None):
-    src = DATA / "lowe_and_langley_2006" / "line.txt"
+def moordyn_jumper_waves(md, case, dtm, folder, duration=None, ei=None):
     phase, heading = WAVE_CASES[case]
     c0, w0 = time.process_time(), time.perf_counter()
-    s = md.Create(str(_input(src, folder, dtm)))
+    s = md.Create(str(_jumper_input(folder, dtm, ei)))
     try:
         point = md.GetPoint(s, 2)
         line = md.GetLine(s, 1)
@@ -264,7 +280,7 @@ def long_runs(md, seconds, quick=False, scenes=("chain", "jumper"), repeat=1):
                      f"RK2; marginal {_marginal(cpu, seconds, np.median(shorts)):.4g}"))
     for case in ([] if "jumper" not in scenes else [2] if quick else [2, 3, 4, 5, 6]):
         scene = f"jumper case {case}, {seconds:g} s"
-        for elements, rtol in ((20, 1e-4), (40, 1e-4)):
+        for elements, rtol in JUMPER_LONG:
             err, cpu, wall, steps = catdae_jumper(case, elements, rtol, seconds)
             rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err / 1e3,
                          JUMPER_TOL / 1e3, cpu, wall, f"{steps} steps"))
@@ -281,6 +297,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--jumper", action="store_true",
+                    help="the jumper's scenes only (as --scenes jumper)")
     ap.add_argument("--long", type=float, default=None,
                     help="seconds of motion: run each scene this long instead (cost of long runs)")
     ap.add_argument("--scenes", default="chain,jumper",
@@ -288,7 +306,7 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=1,
                     help="long chain runs: median cost of this many runs of each code")
     args = ap.parse_args(argv)
-    scenes = tuple(x.strip() for x in args.scenes.split(","))
+    scenes = ("jumper",) if args.jumper else tuple(x.strip() for x in args.scenes.split(","))
     if not set(scenes) <= {"chain", "jumper"}:
         ap.error(f"--scenes: expected chain and/or jumper, got {args.scenes!r}")
     import moordyn as md
@@ -319,11 +337,15 @@ def main(argv=None):
                          "RK2"))
     for case in jumpers:
         scene = f"jumper case {case}"
-        for elements, rtol in ((20, 1e-4), (40, 1e-4), (68, 1e-4)):
+        for elements, rtol in JUMPER_LADDER:
             err, cpu, wall, steps = catdae_jumper(case, elements, rtol)
             rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err / 1e3,
                          JUMPER_TOL / 1e3, cpu, wall, f"{steps} steps"))
         run = moordyn_jumper_waves if case in WAVE_CASES else moordyn_jumper
+        with tempfile.TemporaryDirectory() as d:  # the line without bending stiffness
+            err, cpu, wall = run(md, case, 0.002, Path(d), ei=0.0)
+        rows.append((scene, "MoorDyn 68 segs, EI = 0, dtM 0.002 s", err / 1e3,
+                     JUMPER_TOL / 1e3, cpu, wall, "midpoint5"))
         for dtm, err, cpu, wall in moordyn_ladder(
                 lambda dtm, folder, c=case, run=run: run(md, c, dtm, folder), 0.001):
             e = err if isinstance(err, str) else err / 1e3

@@ -142,7 +142,7 @@ class Builder(CablesPass, ConnectorsPass, StepsPass, SweepPass, TimePass, FluidP
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         self.reference_temperature = top.reference_temperature
-        ground = self.ground(top.ground, self.gravity_direction)
+        ground = self.ground(top.ground)
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)
         self.fluid_lines(top.materials)

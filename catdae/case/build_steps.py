@@ -290,7 +290,7 @@ class StepsPass:
         if v is None or not complete:
             return None
         f = v.frequency if v.frequency == "element" else float(v.frequency)
-        return AxialDamping(ratio=float(v.ratio), frequency=f)
+        return AxialDamping(ratio=float(v.ratio), frequency=f, rate=v.rate)
 
     def damping(self, raw: dict, step_where: tuple) -> Damping | None:
         where = step_where + ("damping",)

@@ -1,6 +1,7 @@
 """``[ground]`` of a case: a height, or a ground profile, below the cables, for the clearance
-results (docs/case-format.md, "Line engineering"). A builder pass (a mixin of
-:class:`~catdae.case.build.Builder`) and the frozen :class:`Ground` it makes."""
+results (docs/case-format.md, "Line engineering"). Under a gravity vector heights are along up
+(= -g) and a profile's stations along the gravity frame's first horizontal axis e1. A builder
+pass (a mixin of :class:`~catdae.case.build.Builder`) and the frozen :class:`Ground` it makes."""
 
 from __future__ import annotations
 
@@ -23,24 +24,33 @@ class _GroundTable(BaseModel):
 
 @dataclass(frozen=True)
 class Ground:
-    """A level ground at ``elevation`` (m, along -gravity), or a profile: height ``z`` at
-    global ``x`` (m, strictly increasing), linear between points, held beyond the ends."""
+    """A level ground at ``elevation`` (m, along -gravity), or a profile: height ``z`` (m, along
+    up = -gravity) at the stations ``x`` (m, strictly increasing), linear between points, held
+    beyond the ends. A station is the point's coordinate along e1, the gravity frame's first
+    horizontal axis (catdae.case.frame.gravity_rotation, its first row: +x with gravity along
+    -z), so the profile is the section of the ground along e1, the same at every e2."""
 
     elevation: float | None = None
     x: tuple[float, ...] = ()
     z: tuple[float, ...] = ()
 
     def height(self, x) -> np.ndarray:
-        """The ground's height below the points of global abscissa ``x``, m."""
+        """The ground's height below the points at the stations ``x`` (along e1), m."""
         if self.elevation is not None:
             return np.full(np.shape(x), self.elevation)
         return np.interp(x, self.x, self.z)
+
+    def gap(self, points, R=None) -> np.ndarray:
+        """Height of the points (..., 3) (global axes) above the ground, m; ``R`` the gravity
+        frame's rotation (local = R global; None: gravity along -z)."""
+        local = np.asarray(points, float) if R is None else np.asarray(points, float) @ R.T
+        return local[..., 2] - self.height(local[..., 0])
 
 
 class GroundPass:
     """``[ground]`` (methods of ``_Builder``)."""
 
-    def ground(self, raw: Any, gravity_direction) -> Ground | None:
+    def ground(self, raw: Any) -> Ground | None:
         if raw is None:
             return None
         where = ("ground",)
@@ -76,9 +86,5 @@ class GroundPass:
             return None
         if not (np.diff(x) > 0).all():
             self.problem(where + ("x",), "expected strictly increasing x")
-            return None
-        if tuple(gravity_direction) != (0.0, 0.0, -1.0):
-            self.problem(where, "a ground profile is given as heights z at x: it needs gravity "
-                         "along -z (give elevation for another gravity direction)")
             return None
         return Ground(x=tuple(map(float, x)), z=tuple(map(float, z)))

@@ -214,10 +214,12 @@ class Damping:
 class AxialDamping:
     """Strain-rate (Kelvin-Voigt) damping of a transient step: a share ``ratio`` of critical at
     ``frequency`` (Hz), or at each element's highest axial frequency (``"element"``); it acts
-    on the axial strain rate only (docs/theory.md §18)."""
+    on the axial strain rate only (docs/theory.md §18), or with ``rate = "chord"`` on the rate
+    of change of the element's chord length (§18.6)."""
 
     ratio: float
     frequency: float | Literal["element"] = "element"
+    rate: Literal["strain", "chord"] = "strain"
 
 
 @dataclass(frozen=True)

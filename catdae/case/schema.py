@@ -203,11 +203,12 @@ class _RayleighDamping(BaseModel):
 
 
 class AxialDampingSchema(BaseModel):
-    """``axial_damping = { ratio = .., frequency = .. }`` of a transient step."""
+    """``axial_damping = { ratio = .., frequency = .., rate = .. }`` of a transient step."""
 
     model_config = STRICT
     ratio: Pos
     frequency: Pos | Literal["element"] = "element"
+    rate: Literal["strain", "chord"] = "strain"
 
 
 DAMPING_MODELS: dict[str, type[BaseModel]] = {

@@ -220,6 +220,7 @@ class Fluid:
             self.a_ground = (wind.ground if wind.ground is not None else
                              self.surface if water is not None else 0.0)
         self.t = 0.0  # time of a static or modal step
+        self.current_factor = 1.0  # times the current: a static step's ramp on a rigid seabed
         self._static_key = None
         self._static = None
         nd = 3 * mesh.n_nodes
@@ -237,7 +238,8 @@ class Fluid:
 
     # ---------------------------------------------------------------------------- time
     def _factors(self, t: float, waves: bool):
-        cf = 1.0 if self.c_time is None else float(self.c_time.evaluate(t)[0])
+        cf = self.current_factor * (1.0 if self.c_time is None else
+                                    float(self.c_time.evaluate(t)[0]))
         af = 1.0 if self.a_time is None else float(self.a_time.evaluate(t)[0])
         r, dr = 1.0, 0.0
         if waves and self._ramp is not None:
@@ -271,7 +273,7 @@ class Fluid:
         water at the static time ``self.t`` (buoyancy, steady current and wind drag; no
         waves). The last result is kept for the positions it was computed at."""
         X = np.asarray(X, float).reshape(-1)
-        key = (self.t, X.tobytes())
+        key = (self.t, self.current_factor, X.tobytes())
         if self._static_key != key:
             z = np.zeros(X.size)
             out, _, kx, _ = self.evaluate(self.t, X, z, z, want_jac=True, waves=False)

@@ -100,20 +100,6 @@ class GroundedElements:
         return out
 
 
-def _no_drag_resting(model: Model, mode: np.ndarray, zb: float) -> None:
-    """A current at the rigid seabed's height drags the resting line, which nothing holds
-    there (no friction in statics, a straight lying part): say so (no equilibrium)."""
-    fl = model.fluid
-    resting = np.flatnonzero((mode != g.FREE) & ((fl.cdn > 0.0) | (fl.cda > 0.0)))
-    u = fl.kinematics(np.array([[0.0, 0.0, zb]]), fl.t, waves=False)[1][0]
-    if resting.size and (speed := float(np.linalg.norm(u))) > 0.0:
-        raise ConvergenceError(
-            f"element {model.mesh.element_names[int(resting[0])]} rests on the rigid seabed in a "
-            f"current of {speed:.3g} m/s at the seabed's height: a frictionless rigid seabed "
-            "holds no drag on the line lying on it (no static equilibrium); give [seabed] "
-            "stiffness, or a current profile that is zero at the seabed")
-
-
 class GroundedModel(Model):
     """``model`` on a rigid, frictionless seabed at ``zb``: the free nodes of ``contact``
     (n_nodes,) bool held at z_b, the elements with an end ``on`` the seabed grounded."""
@@ -135,8 +121,6 @@ class GroundedModel(Model):
                 f"element {name} rests on the seabed and carries loads inside it (point loads, "
                 "point masses or distributed loads): the rigid seabed statics takes loads at "
                 "nodes only; give [seabed] stiffness, or put the loads at nodes")
-        if model.fluid is not None:
-            _no_drag_resting(model, self.mode, zb)
         self.elements = GroundedElements(model.elements, self.mode)
         fixed = model.fixed_mask.copy()
         fixed[contact, 2] = True

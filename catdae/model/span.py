@@ -58,8 +58,8 @@ def span_quantities(model, X: np.ndarray, state) -> dict[str, np.ndarray]:
 
 def clearances(model, X, state, ground, s, pts) -> dict[str, np.ndarray]:
     """Per cable the least height of the cable above ``ground`` (a catdae.case.ground.Ground:
-    heights are z, abscissae x of the gravity frame, which is the case's frame whenever a
-    profile is allowed), ``clearance`` m, and where, ``clearance_s`` m (unstrained arc length
+    heights are z, a profile's stations x of the gravity frame, where the model is solved:
+    along up and e1), ``clearance`` m, and where, ``clearance_s`` m (unstrained arc length
     at the reference temperature): the lowest sample refined on its element's exact curve."""
     from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
 

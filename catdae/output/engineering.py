@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
+from catdae.case.frame import gravity_rotation
 
 _SPAN = {  # name: (units, long_name)
     "horizontal_tension_along_chord": (
@@ -125,9 +126,8 @@ def clearance_over_time(ds: xr.Dataset, ground, cables: list[str],
                         up: np.ndarray | None = None) -> dict[str, xr.Variable]:
     """Per cable the least height of its nodes above the ground over the output times, when
     and where (at the nodes: between nodes the exact curve is not stored in a transient)."""
-    up = np.array([0.0, 0.0, 1.0]) if up is None else np.asarray(up, float)
-    x = ds.position.values  # (time, node, 3) m
-    gap = x @ up - ground.height(x[..., 0])  # (time, node) m
+    R = None if up is None else gravity_rotation(-np.asarray(up, float))
+    gap = ground.gap(ds.position.transpose(..., "axis").values, R)  # (time, node) m
     least, when, where = [], [], []
     for c in cables:
         sel = ds.element_cable.values == c

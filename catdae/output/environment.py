@@ -4,9 +4,10 @@
 Every step group of a scene with ``[water]`` or ``[seabed]`` carries the attributes
 ``up`` (the unit vector against gravity), ``water_surface`` (m, the height of the still-water
 level along ``up``), ``water_depth`` (m, with a finite depth) and ``seabed_z`` (m, the height of
-the seabed along ``up``) (:func:`environment_attrs`). The planes are drawn in the gravity frame
+the seabed along ``up``) (:func:`environment_attrs`); with a gravity vector not along -z, every
+group carries ``up`` even without water or seabed. The planes are drawn in the gravity frame
 (catdae.case.frame: z along ``up``) over the horizontal extent of the cables, and turned back
-into the case's axes.
+into the case's axes; so is the profile figure under a gravity vector (:func:`drawing_frame`).
 """
 
 from __future__ import annotations
@@ -25,9 +26,11 @@ MAX_SIDE = 101  # points per side of a water-surface grid at most
 def environment_attrs(case) -> dict:
     """The attributes of every step group of ``case`` (module docstring); {} without water and
     seabed."""
+    up = np.array([-float(g) for g in case.gravity_direction])
     if case.water is None and case.seabed is None:
-        return {}
-    out = {"up": np.array([-float(g) for g in case.gravity_direction])}
+        # a gravity vector alone: ``up``, so that the profile figure draws heights upwards
+        return {} if np.array_equal(up, (0.0, 0.0, 1.0)) else {"up": up}
+    out = {"up": up}
     if case.water is not None:
         out["water_surface"] = float(case.water.surface)
         if math.isfinite(case.water.depth):
@@ -82,13 +85,33 @@ def wave_grid_size(waves, g: float, depth: float, lo, hi) -> tuple[int, int]:
                  for low, h in zip(lo, hi, strict=True))
 
 
+def drawing_frame(ds: xr.Dataset) -> np.ndarray | None:
+    """The rotation R (local = R global) in which the profile figure draws the group: its
+    gravity frame (x, y horizontal, z along ``up``) when ``up`` is not +z; None when it is (the
+    case's own axes, as they are)."""
+    up = np.asarray(ds.attrs.get("up", (0.0, 0.0, 1.0)), float).reshape(-1)
+    if up.size != 3 or np.allclose(up, (0.0, 0.0, 1.0), rtol=0, atol=1e-12):
+        return None
+    return frame_of(ds)
+
+
+def axis_names(R: np.ndarray | None) -> tuple[str, str, str]:
+    """How the profile figure names its three directions: the case's x, y, z, or in the
+    gravity frame the two horizontal unit vectors and the height along up, in global axes."""
+    if R is None:
+        return "x", "y", "z"
+
+    def vec(v):
+        return "(" + ", ".join(f"{float(c) + 0.0:.4g}" for c in v) + ")"
+
+    return (f"along e1 = {vec(R[0])}", f"along e2 = {vec(R[1])}",
+            f"height along up = {vec(R[2])}")
+
+
 def still_levels(ax, ds: xr.Dataset) -> None:
     """The seabed (solid) and the still-water level (dotted) across the elevation, when the
-    group has them and z is up (with a gravity vector the elevation shows global z, not the
-    height, and they are left out; the ParaView export draws them in any frame)."""
-    up = np.asarray(ds.attrs.get("up", (0.0, 0.0, 1.0)), float).reshape(-1)
-    if up.size != 3 or not np.allclose(up, (0.0, 0.0, 1.0), rtol=0, atol=1e-12):
-        return
+    group has them. The elevation's vertical is the height along ``up`` in any frame
+    (:func:`drawing_frame`), so both are horizontal lines at their heights."""
     if "seabed_z" in ds.attrs:
         ax.axhline(float(ds.attrs["seabed_z"]), color="saddlebrown", lw=1.2, label="seabed",
                    gid="seabed")

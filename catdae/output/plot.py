@@ -5,7 +5,7 @@ Each function takes a step's group (an ``xarray.Dataset``, or a DataTree node) a
 The figures are made without pyplot (``Figure`` objects, saved through the Agg canvas): no
 window, no global state, and a notebook's own backend is left alone.
 
-- :func:`profile`: the cable's shape at chosen times, elevation (x-z) and plan (x-y);
+- :func:`profile`: the cable's shape at chosen times, elevation (heights up) and plan;
 - :func:`history`: a node's displacement over time, per axis;
 - :func:`spectrum`: the amplitude spectrum of that displacement;
 - :func:`tension`: tension along each cable (at chosen times) and at the supports over time;
@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 from catdae._xr import xr
 from catdae.errors import CatdaeError
 from catdae.interrupts import deferred
-from catdae.output.environment import still_levels
+from catdae.output.environment import axis_names, drawing_frame, still_levels
 from catdae.output.plot_envelopes import mark_peaks, reactions
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
@@ -115,33 +115,38 @@ def _times(ds: xr.Dataset, times) -> np.ndarray:
 
 def profile(data, times=None, what: str = "position") -> Figure:
     """The cable at the given times (nearest stored ones; static: its one state): elevation
-    (x-z) above, plan (x-y) below."""
+    above, plan below. Drawn in the case's axes (x-z, x-y) when z is up; under a gravity vector
+    in the gravity frame (catdae.output.environment.drawing_frame): the vertical of the
+    elevation is the height along up (= -g), the horizontal axes are e1, e2 normal to g. The
+    seabed, the still-water level and the instantaneous surface are at their heights."""
     ds = _ds(data, "profile")
     var = ds[what]
     fig, (ax_e, ax_p) = _subplots(2, 1, figsize=(8, 7), sharex=True)
     states = [(None, var)] if "time" not in var.dims else [
         (t, var.sel(time=t)) for t in _times(ds, times)]
     paths = _paths(ds)
+    R = drawing_frame(ds)
     for t, x in states:
         for k, (cab, nodes) in enumerate(paths.items()):
-            pts = x.sel(node=nodes)
+            pts = np.asarray(x.sel(node=nodes).transpose("node", "axis").values, float)
+            if R is not None:
+                pts = pts @ R.T  # (horizontal e1, e2, height along up)
             tag = cab if t is None else f"{cab}, t = {t:.4g} s"
             lab = tag if (k == 0 or len(paths) > 1) else None
-            line, = ax_e.plot(pts.sel(axis="x"), pts.sel(axis="z"), marker=".", label=lab,
-                              gid=f"{cab}|{t}")
-            ax_p.plot(pts.sel(axis="x"), pts.sel(axis="y"), marker=".", color=line.get_color(),
-                      gid=f"{cab}|{t}")
+            line, = ax_e.plot(pts[:, 0], pts[:, 2], marker=".", label=lab, gid=f"{cab}|{t}")
+            ax_p.plot(pts[:, 0], pts[:, 1], marker=".", color=line.get_color(), gid=f"{cab}|{t}")
             if t is not None and "surface_elevation" in ds and what == "position":
                 # the water surface above the cable's nodes (docs/case-format.md)
-                eta = ds.surface_elevation.sel(time=t, node=nodes)
-                ax_e.plot(pts.sel(axis="x"), ds.attrs.get("water_surface", 0.0) + eta,
+                eta = ds.surface_elevation.sel(time=t, node=nodes).values
+                ax_e.plot(pts[:, 0], ds.attrs.get("water_surface", 0.0) + eta,
                           ls="--", lw=0.8, color=line.get_color(), gid=f"surface|{cab}|{t}")
     if what == "position":
         still_levels(ax_e, ds)
     name = var.attrs.get("long_name", what)
-    ax_e.set_ylabel(label(var, f"{name}, z"))
-    ax_p.set_ylabel(label(var, f"{name}, y"))
-    ax_p.set_xlabel(label(var, f"{name}, x"))
+    e1, e2, up = axis_names(R)
+    ax_e.set_ylabel(label(var, f"{name}, {up}"))
+    ax_p.set_ylabel(label(var, f"{name}, {e2}"))
+    ax_p.set_xlabel(label(var, f"{name}, {e1}"))
     ax_e.set_title("elevation")
     ax_p.set_title("plan")
     ax_e.legend(fontsize="small")

@@ -27,6 +27,11 @@ that of two lumped halves), and c_d = ζ sqrt(EA m): ζ times the wave impedance
 every element of a cable whatever the mesh. A mode of frequency ω then gets ζ ω L0 / (2c),
 which vanishes as the mesh is refined: damping of what the mesh cannot resolve, like the
 numerical dissipation of a generalised-α scheme, but acting on the axial strain only.
+
+``rate = "chord"`` puts the same c_d on the rate of change of the chord length instead,
+ė = ĉ·ċ and g = ĉ (MoorDyn's BA on its straight segments, whose elongation is all strain):
+in a sagging element it also damps the breathing of the element's sag, which the strain rate
+hardly sees (g = K ∂e/∂h is about 12/λ² of ĉ there, docs/theory.md §18.6).
 """
 
 from __future__ import annotations
@@ -68,6 +73,32 @@ def axial_rates(conn, X, V, h, kmat, l0, ea, w, ptr, ls, lf, g, edot):
 
 
 @njit(cache=True)
+def unit_chord(c, k, out):
+    """out[:] = the unit vector of c[k:k + 3] (zero for a zero chord)."""
+    n2 = c[k] * c[k] + c[k + 1] * c[k + 1] + c[k + 2] * c[k + 2]
+    inv = 1.0 / np.sqrt(n2) if n2 > 0.0 else 0.0
+    for a in range(3):
+        out[a] = c[k + a] * inv
+
+
+@njit(cache=True)
+def chord_rates(conn, X, V, g, edot):
+    """g = ĉ (n, 3), the unit chord, and ė = ĉ·ċ (n,), the rate of change of the chord length,
+    of every element at positions X, velocities V (full dofs)."""
+    c = np.empty(3)
+    for e in range(conn.shape[0]):
+        i = 3 * conn[e, 0]
+        j = 3 * conn[e, 1]
+        for a in range(3):
+            c[a] = X[j + a] - X[i + a]
+        unit_chord(c, 0, g[e])
+        rate = 0.0
+        for a in range(3):
+            rate += g[e, a] * (V[j + a] - V[i + a])
+        edot[e] = rate
+
+
+@njit(cache=True)
 def add_forces(conn, cd, g, edot, out):
     """out (n_dof,) += the element damping forces on the full dofs."""
     for e in range(conn.shape[0]):
@@ -99,11 +130,13 @@ def add_residual(conn, cd, g, edot, unknown, res):
 class AxialDamping:
     """The strain-rate damping of one transient step: coefficients and evaluations."""
 
-    def __init__(self, model, ratio: float, frequency: float | str, fidx=None):
+    def __init__(self, model, ratio: float, frequency: float | str, fidx=None,
+                 rate: str = "strain"):
         el = model.elements
         mesh = model.mesh
         self.ratio = float(ratio)
         self.frequency = frequency
+        self.chord = rate == "chord"  # on the chord's rate (MoorDyn's segments), §18.6
         if frequency == "element":
             # ω_e = 2 c / L0: c_d = 2 ζ EA / (ω_e L0) = ζ sqrt(EA m)
             self.cd = self.ratio * np.sqrt(el.EA * mesh.m)
@@ -130,17 +163,21 @@ class AxialDamping:
         spec = getattr(step, "axial_damping", None)
         if spec is None:
             return None
-        return cls(model, spec.ratio, spec.frequency, fidx)
+        return cls(model, spec.ratio, spec.frequency, fidx, getattr(spec, "rate", "strain"))
 
     def describe(self) -> str:
+        on = " on the chord's rate" if self.chord else ""
         if self.frequency == "element":
             f = self.f_element
             return (f"{100 * self.ratio:g} % of critical at each element's highest axial "
-                    f"frequency ({np.nanmin(f):.4g}-{np.nanmax(f):.4g} Hz)")
-        return f"{100 * self.ratio:g} % of critical at {float(self.frequency):g} Hz"
+                    f"frequency ({np.nanmin(f):.4g}-{np.nanmax(f):.4g} Hz){on}")
+        return f"{100 * self.ratio:g} % of critical at {float(self.frequency):g} Hz{on}"
 
     def rates(self, X, V, h, kmat) -> None:
         """g and ė at positions X, velocities V (full dofs) and the solved h, kmat."""
+        if self.chord:
+            chord_rates(self._conn, X, V, self.g, self.edot)
+            return
         el = self._model.elements
         axial_rates(self._conn, X, V, h, kmat, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf,
                     self.g, self.edot)

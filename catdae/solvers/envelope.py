@@ -21,21 +21,20 @@ from numba import njit
 
 from catdae.element.catenary import NOT_CONVERGED, solve_one
 from catdae.element.catenary_batch import solve_batch
-from catdae.solvers.axial_damping import element_g
+from catdae.solvers.axial_damping import element_g, unit_chord
 
 CARRY = 1e-4  # largest relative change of an end force carried to first order
 
 
 @njit(cache=True)
 def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf,
-                     load_total, cd, g, out):
+                     load_total, cd, g, chord, out):
     """End tensions (n, 2) at the state y (positions and velocities of the unknowns in
     ``fidx``, interleaved; fixed dofs at ``xp``/``vp``) from the end forces ``hb`` and
     stiffnesses ``kb`` solved at positions ``xb``: h = hb + kb (c - c_b) where the change
     |kb (c - c_b)| is below ``CARRY`` |hb|, else the element is solved again (warm-started from
-    hb). Plus the viscous tension cd ė, ė = g·ċ (cd all zero without axial damping; g taken
-    again where the element is solved again). Returns the number of elements solved, -1 if
-    one cannot be."""
+    hb). Plus the viscous tension cd ė, ė = g·ċ (cd zero without axial damping; g taken again
+    where solved again; ``chord``: the unit chord). Returns the elements solved (-1: one failed)."""
     X = xb.copy()
     V = np.zeros(xb.shape[0])
     for k in range(fidx.shape[0]):
@@ -73,8 +72,10 @@ def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, l
             if status == NOT_CONVERGED:
                 return -1
             solved += 1
-            if cd[e] != 0.0:
+            if cd[e] != 0.0 and not chord:
                 element_g(i, j, X, h, k33, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], ge)
+        if chord and cd[e] != 0.0:
+            unit_chord(c, 0, ge)
         rate = 0.0
         for a in range(3):
             rate += ge[a] * (V[j + a] - V[i + a])
@@ -122,10 +123,11 @@ class TensionEnvelope:
         xp, vp, _ = prob._supports(t)
         ax = prob.axial
         cd, g = (ax.cd, ax.g) if ax is not None else (self._zero_cd, self._zero_g)
+        chord = ax is not None and ax.chord
         el = prob.model.elements
         solved = carried_tensions(y, prob._fidx, prob._fixed, xp, vp, prob._conn, prob._Xb,
                                   prob._hw, prob._kmat, el.L0, el.EA, el.w, el._ptr, el._ls,
-                                  el._lf, el._load_total, cd, g, self._out)
+                                  el._lf, el._load_total, cd, g, chord, self._out)
         if solved < 0:
             return None
         self.n_elements_solved += solved

@@ -39,10 +39,17 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
     support_on = fixed_z & (np.abs(X[:, 2] - zb) <= ztol)
     start = grounded_start(model, X, support_on)
     try:
-        return _active_set(model, zb, start, h0, t, load_steps, max_rounds, ztol, fscale,
+        return _active_set(model, zb, start.copy(), h0, t, load_steps, max_rounds, ztol, fscale,
                            support_on)
     except ConvergenceError:
         pass
+    if model.fluid is not None and model.fluid.water is not None and \
+            model.fluid.water.current is not None:
+        try:
+            return _current_ramp(model, zb, start, (t, load_steps, max_rounds, ztol, fscale,
+                                                    support_on))
+        except ConvergenceError:
+            pass
     # a first approach on stiff penalty springs (no grounded elements, no active set), whose
     # equilibrium gives the active set nearly right: penetration w/k = 1e-4 element lengths
     mesh = model.mesh
@@ -54,9 +61,62 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
                        support_on)
 
 
-def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, support_on):
+def _current_ramp(model, zb, X, args):
+    """The equilibrium in a current reached from the one without it: the current times 0,
+    then times factors growing to 1, each stage an active set started from the last. The drag
+    moves the resting part in plan and the touchdown along the line; when a stage's touchdown
+    leaves the touchdown element (Newton at a fixed set cannot follow it), the stage is tried
+    again with the set grown or shrunk by the nodes next to the touchdown, then halved."""
+    fl = model.fluid
+    lam, dlam = 0.0, 0.25
+    try:
+        fl.current_factor = 0.0
+        sol, gm = _active_set(model, zb, X.copy(), None, *args)
+        while lam < 1.0:
+            target = min(1.0, lam + dlam)
+            fl.current_factor = target
+            found = _stage(model, zb, sol, gm.contact, args)
+            if found is None:
+                dlam *= 0.5
+                if dlam < 1.0 / 64.0:
+                    raise ConvergenceError("static step on the seabed in a current: no "
+                                           "equilibrium found by raising the current")
+                continue
+            sol, gm = found
+            lam = target
+            dlam = min(2.0 * dlam, 0.5)
+    finally:
+        fl.current_factor = 1.0
+    return sol, gm
+
+
+def _stage(model, zb, sol, contact, args):
+    """One stage of :func:`_current_ramp` from ``sol`` with the nodes ``contact`` on the
+    seabed, then with the free nodes next to them added, then with the touchdown-side nodes
+    of the set removed; None when none converges."""
     fixed_z = model.fixed_mask[:, 2]
-    contact = ~fixed_z & (X[:, 2] <= zb + ztol)
+    conn = model.mesh.conn
+    a, b = contact[conn[:, 0]], contact[conn[:, 1]]
+    edge = np.zeros_like(contact)
+    edge[conn[a & ~b, 1]] = True
+    edge[conn[b & ~a, 0]] = True
+    grow = contact | (edge & ~fixed_z)
+    last = np.zeros_like(contact)
+    last[conn[a & ~b, 0]] = True
+    last[conn[b & ~a, 1]] = True
+    for trial in (contact, grow, contact & ~last):
+        try:
+            return _active_set(model, zb, sol.X.copy(), sol.state.h, *args, contact=trial)
+        except ConvergenceError:
+            continue
+    return None
+
+
+def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, support_on,
+                contact=None):
+    fixed_z = model.fixed_mask[:, 2]
+    if contact is None:
+        contact = ~fixed_z & (X[:, 2] <= zb + ztol)
     h = h0
     seen: set[bytes] = set()
     for _ in range(max_rounds):
@@ -64,14 +124,12 @@ def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, suppo
         gm = GroundedModel(model, contact, contact | support_on, zb)
         sol = solve_static(gm, X, h, t=t, load_steps=load_steps)
         X, h = sol.X, sol.state.h
-        r = gm.internal_force(sol.state, X) - gm.nodal_load(t)
-        if gm.fluid is not None:  # the fluid's static forces, as in the static residual
-            r = r + gm.fluid.static(X)[0]
-        rz = r.reshape(-1, 3)[:, 2]  # what the seabed must push up with at each node
+        rz = seabed_push(gm, sol.state, X, t)  # what the seabed must push up with
         below = ~fixed_z & ~contact & (X[:, 2] < zb - ztol)
         pulling = contact & (rz < -1e-9 * fscale)
         if not below.any() and not pulling.any():
             _check_dips(gm, sol, zb, ztol)
+            _check_slack_resting(gm, sol, fscale)
             return sol, gm
         seen.add(contact.tobytes())
         contact = (contact | below) & ~pulling
@@ -79,6 +137,29 @@ def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, suppo
             break
     raise ConvergenceError("static step on the seabed: the set of nodes resting on the seabed "
                            "does not settle")
+
+
+def seabed_push(gm: GroundedModel, state, X: np.ndarray, t: float) -> np.ndarray:
+    """(n_nodes,) N: the vertical force the seabed must push up with at each node for the
+    equilibrium of ``gm``: the elements' and the loads' vertical forces, and the fluid's static
+    forces (buoyancy, drag), except at nodes whose elements all hold their buoyancy in their
+    weight. There the fluid's force is drag alone, and its vertical part at a node on the
+    seabed is that of the inclined chord of the touchdown element (the drag is lumped from the
+    chords), where the resting line is horizontal: a horizontal current's drag on it has no
+    vertical part. The seabed takes it either way; it vanishes as the element length does
+    (docs/theory.md §17.4)."""
+    r = gm.internal_force(state, X) - gm.nodal_load(t)
+    fl = gm.fluid
+    if fl is not None:  # the fluid's static forces, as in the static residual
+        f = fl.static(X)[0].reshape(-1, 3).copy()
+        conn = gm.mesh.conn
+        drag_only = np.ones(gm.mesh.n_nodes, bool)
+        held = np.asarray(fl.in_weight, bool)
+        drag_only[conn[~held, 0]] = False
+        drag_only[conn[~held, 1]] = False
+        f[drag_only, 2] = 0.0
+        r = r + f.reshape(-1)
+    return r.reshape(-1, 3)[:, 2]
 
 
 def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray) -> np.ndarray:
@@ -136,6 +217,26 @@ def _check_dips(gm: GroundedModel, sol, zb: float, ztol: float) -> None:
             f"element {gm.mesh.element_names[int(bad[0])]} dips below the seabed between its "
             "nodes with both ends off it: use more elements on that cable, so that a node "
             "falls on the lying part")
+
+
+def _check_slack_resting(gm: GroundedModel, sol, fscale: float) -> None:
+    """In a current, a resting element without tension: the drag along the resting part has
+    taken its tension to zero before the anchor, and on a frictionless seabed the rest of it
+    has nothing to hold it (the line would pile up at the anchor): no equilibrium, say so."""
+    fl = gm.fluid
+    if fl is None or fl.water is None or fl.water.current is None:
+        return
+    resting = np.flatnonzero(gm.mode != g.FREE)
+    if resting.size == 0:
+        return
+    t = gm.tensions(sol.state)[resting].max(axis=1)
+    slack = resting[t <= 1e-9 * fscale]
+    if slack.size:
+        raise ConvergenceError(
+            f"element {gm.mesh.element_names[int(slack[0])]} rests slack on the rigid seabed: "
+            "the current's drag along the resting part takes its tension to zero before the "
+            "anchor, and a frictionless seabed holds nothing there (the line would pile up at "
+            "the anchor): no static equilibrium")
 
 
 def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str, np.ndarray]:

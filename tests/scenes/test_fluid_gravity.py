@@ -47,8 +47,7 @@ def vec(v):
 def water_scene(Q, rigid: bool = False) -> str:
     """A chain from an anchor on the seabed (50 m of water) to a fairlead 3 m above the
     surface, in a current profile, Airy waves and a power-law wind; turned by Q. On a rigid
-    seabed (statics only) the current is zero at the bed: the exact grounded elements take no
-    drag while resting (docs/case-format.md, "Seabed")."""
+    seabed (statics only) the current is zero at the bed (the resting part then straight)."""
     off = heading_offset(Q)
     bottom = [0.0, 0.0, 0.0] if rigid else [0.2, 0.1, 0.0]
     cur = [vec(Q @ np.array(u)) for u in (bottom, [0.6, 0.3, 0.0])]
@@ -137,10 +136,25 @@ def test_static_fluid_velocity_is_the_current_profile_and_the_wind_law(upright):
     np.testing.assert_allclose(ds.fluid_velocity.values, want, rtol=1e-12, atol=1e-14)
 
 
-def test_rigid_seabed_in_a_current_at_its_height_is_refused_plainly():
-    # a frictionless rigid seabed cannot hold the drag on the line resting on it
-    text = water_scene(np.eye(3), rigid=True).replace("[[0.0, 0.0, 0.0], [0.6", "[[0.05, 0.0, "
-                                                                                "0.0], [0.6")
-    with pytest.raises(catdae.errors.ConvergenceError, match="rests on the rigid seabed in a "
-                       "current of 0.05 m/s"):
-        catdae.run(catdae.load_case(text), progress=False)
+@pytest.mark.parametrize("turn", TURNS)
+def test_turned_chain_on_a_rigid_seabed_with_current_at_the_bed_is_the_turned_answer(turn):
+    # a current at the seabed's height (0.3 m/s across the chain at the bed) moves the resting
+    # part in plan (tests/scenes/test_seabed_current.py); turned with its gravity and current
+    Q = TURNS[turn]
+    a = catdae.run(catdae.load_case(_with_bottom(water_scene(np.eye(3), rigid=True),
+                                                 [-0.1, 0.3, 0.0])))["s"].ds
+    b = catdae.run(catdae.load_case(_with_bottom(water_scene(Q, rigid=True),
+                                                 vec(Q @ np.array([-0.1, 0.3, 0.0])))))["s"].ds
+    assert float(a.seabed_length.values[0]) > 10.0
+    assert abs(float(a.touchdown.sel(cable="c", axis="y")) - float(a.touchdown.sel(
+        cable="c", axis="x")) * 20.0 / 80.0) > 0.2  # off the chord in plan (0.47 m; 0.03 m
+    # without the current at the bed)
+    for var in ("position", "reaction", "tension", "seabed_length", "touchdown"):
+        _close(b[var], a[var], Q, 1e-9)
+
+
+def _with_bottom(text: str, bottom: list[float]) -> str:
+    """The scene with the current profile's bottom velocity replaced by ``bottom``."""
+    head, _, rest = text.partition("velocity = [[")
+    _, _, tail = rest.partition("], [")
+    return f"{head}velocity = [{bottom}, [{tail}"

@@ -59,26 +59,17 @@ def test_chain_heave_against_orcaflex(depth, motion):
     assert chain_metric(ds.time.values, tension, depth, motion, static) <= 0.15
 
 
-@pytest.mark.parametrize("case", [2, 4, 5, 6])
+@pytest.mark.parametrize("case", [2, 3, 4, 5, 6])
 def test_jumper_against_lowe_and_langley(case):
-    """Jumper cases 2 (top sway, 80 s after the ramp) and 4-6 (Airy waves from three
-    headings, 30 s after two periods), 40 elements, rtol 1e-4, MoorDyn's axial damping: the
-    top tension within 1.5 kN of the paper's curves at every compared point (MoorDyn with its
-    EI: 0.33-0.94 kN)."""
-    tree = _run(jumper_toml(case=case, elements=40, rtol=1e-4))
+    """Jumper cases 2 (top sway) and 3 (top heave: from 5 m below the surface out of the water
+    and back), 80 s after the ramp, and 4-6 (Airy waves from three headings, 30 s after two
+    periods), 40 elements, rtol 3e-5, MoorDyn's axial damping on the chord rate as its straight
+    segments have it: the top tension within 1.5 kN of the paper's curves at every compared
+    point (MoorDyn with its EI: 0.33-0.94 kN; with EI = 0 on case 3: 0.81-0.94 kN at 20-68
+    segments). On the strain rate case 3 missed (1.74 kN at rtol 1e-4, 6.2 kN at 20 elements):
+    the sag breathing of the elements rang undamped at about 1 Hz (benchmarks/
+    moordyn_validation.md)."""
+    tree = _run(jumper_toml(case=case, elements=40, rtol=3e-5))
     ds = tree[f"case{case}"].to_dataset()
     tension = np.linalg.norm(ds.reaction.sel(node="top").values, axis=-1)
     assert jumper_error(ds.time.values, tension, case) <= 1.5e3
-
-
-@pytest.mark.xfail(strict=True, reason="not met: 1.74 kN at 40 elements (issue 21)")
-def test_jumper_case3_against_lowe_and_langley():
-    """Jumper case 3 (the top heaves 10 m from 5 m below the surface, out of the water and
-    back), 40 elements, rtol 1e-4: within 1.5 kN of the paper (MoorDyn with its EI: 0.81 kN).
-    Not met: 1.74 kN at 40 elements, 2.15 at 68, on the flanks where the top descends fast
-    (t = 42-46 s and 69-72 s), where catdae's top tension rises in a 1-2 Hz wobble about the
-    paper's smooth curve."""
-    tree = _run(jumper_toml(case=3, elements=40, rtol=1e-4))
-    ds = tree["case3"].to_dataset()
-    tension = np.linalg.norm(ds.reaction.sel(node="top").values, axis=-1)
-    assert jumper_error(ds.time.values, tension, 3) <= 1.5e3

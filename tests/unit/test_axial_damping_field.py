@@ -28,6 +28,9 @@ def test_read_as_written():
     assert step.axial_damping.ratio == 0.02 and step.axial_damping.frequency == 40.0
     step = load_case(_case({"ratio": 0.5})).steps[1]
     assert step.axial_damping.frequency == "element"
+    assert step.axial_damping.rate == "strain"
+    step = load_case(_case({"ratio": 0.5, "rate": "chord"})).steps[1]
+    assert step.axial_damping.rate == "chord"
     assert load_case(_case()).steps[1].axial_damping is None
 
 
@@ -37,6 +40,7 @@ def test_read_as_written():
     ({"ratio": 0.1, "frequency": "high"}, "steps[1].axial_damping.frequency", "element"),
     (0.05, "steps[1].axial_damping", "expected a table"),
     ({"ratio": 0.1, "zeta": 2}, "steps[1].axial_damping.zeta", ""),
+    ({"ratio": 0.1, "rate": "segment"}, "steps[1].axial_damping.rate", "chord"),
 ])
 def test_bad_values_are_named(damping, where, expected, tmp_path):
     with pytest.raises(CaseError) as info:

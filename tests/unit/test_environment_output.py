@@ -27,9 +27,11 @@ H, T, BETA, PHI, DEPTH, G = 1.0, 4.0, 30.0, 40.0, 20.0, 9.81
 
 def _scene(gravity=None, waves: bool = True) -> str:
     """An anchor on the seabed in 20 m of water, a fairlead 2 m above the surface; with
-    ``gravity`` "x" gravity acts along -x (heights are then x, the scene turned alike)."""
-    Q = np.eye(3) if gravity is None else np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0],
-                                                    [-1.0, 0.0, 0.0]])  # z -> x
+    ``gravity`` "x" gravity acts along -x (heights are then x, the scene turned alike); with a
+    rotation matrix, the scene and its gravity turned by it."""
+    Q = np.eye(3) if gravity is None else np.asarray(gravity, float) if not isinstance(
+        gravity, str) else np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0],
+                                     [-1.0, 0.0, 0.0]])  # z -> x
     wave = (f'waves = {{ kind = "airy", height = {H}, period = {T}, heading = {BETA}, '
             f"phase = {PHI} }}\n" if waves else "")
     steps = step("static", "s") + (step("transient", "t", duration=0.5, output_interval=0.25,
@@ -101,6 +103,76 @@ def test_profile_draws_the_seabed_the_still_level_and_the_surface(waves):
                                                       pos.sel(axis="y").values, 0.5)
                                [[list(ds.node.values).index(n) for n in
                                  plot.cable_paths(ds)["c"]]], atol=1e-12)
+
+
+# gravity along +x, the upright scene's x, y, z turned to y, -z, -x: the gravity frame of the
+# turned scene (its horizontal e1 = y, e2 = -z, up = -x) is the upright scene's x, y, z
+G_PLUS_X = np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+
+
+def _lines(fig):
+    """{(panel, gid): (xdata, ydata)} of a figure's data lines."""
+    return {(k, str(ln.get_gid())): (np.asarray(ln.get_xdata(), float),
+                                     np.asarray(ln.get_ydata(), float))
+            for k, ax in enumerate(fig.axes[:2]) for ln in ax.get_lines()}
+
+
+def test_profile_under_gravity_along_x_is_the_upright_drawing(waves):
+    # the turned scene's figure draws in its gravity frame: every line (the cable at each time
+    # in elevation and plan, the seabed, the still-water level, the wave surface above the
+    # nodes) has the upright figure's data, to round-off; only the axis labels differ
+    _, upright = waves
+    turned = catdae.run(catdae.load_case(_scene(gravity=G_PLUS_X)), progress=False)
+    np.testing.assert_array_equal(turned["s"].to_dataset().attrs["up"], [-1.0, 0.0, 0.0])
+    for name, times in (("s", None), ("t", [0.0, 0.25, 0.5])):
+        a = _lines(plot.profile(upright[name], times=times))
+        fig = plot.profile(turned[name], times=times)
+        b = _lines(fig)
+        assert a.keys() == b.keys()
+        assert {"seabed", "still water"} <= {g for _, g in a}
+        for key, (xa, ya) in a.items():
+            np.testing.assert_allclose(b[key][0], xa, rtol=0, atol=1e-9 * 40.0, err_msg=key)
+            np.testing.assert_allclose(b[key][1], ya, rtol=0, atol=1e-9 * 40.0, err_msg=key)
+        assert fig.axes[0].get_ylabel().endswith("height along up = (-1, 0, 0) [m]")
+        assert "along e1 = (0, 1, 0)" in fig.axes[1].get_xlabel()
+    assert len([k for k in a if k[1].startswith("surface|")]) == 3
+
+
+def test_profile_under_an_oblique_gravity_draws_heights_along_up():
+    # closed form: the elevation's vertical of every node is its position along up = -g, the
+    # seabed and the still-water level are the lines at -20 m and 0 m; the plan keeps the
+    # horizontal distances (the turn about up is the frame's own choice)
+    Q = TURN_OBLIQUE
+    tree = catdae.run(catdae.load_case(_scene(gravity=Q, waves=False)), progress=False)
+    ds = tree["s"].to_dataset()
+    up = Q @ np.array([0.0, 0.0, 1.0])
+    np.testing.assert_allclose(ds.attrs["up"], up, rtol=0, atol=1e-15)
+    lines = _lines(plot.profile(tree["s"]))
+    pos = ds.position.sel(node=plot.cable_paths(ds)["c"]).transpose("node", "axis").values
+    xe, ye = lines[(0, "c|None")]
+    np.testing.assert_allclose(ye, pos @ up, rtol=0, atol=1e-12 * 40.0)
+    xp, yp = lines[(1, "c|None")]
+    np.testing.assert_allclose(xp, xe, rtol=0, atol=0)
+    flat = pos - np.outer(pos @ up, up)  # horizontal parts: distances kept in the plan
+    d_plan = np.hypot(xp[:, None] - xp, yp[:, None] - yp)
+    np.testing.assert_allclose(d_plan, np.linalg.norm(flat[:, None] - flat, axis=2), rtol=0,
+                               atol=1e-12 * 40.0)
+    assert set(lines[(0, "seabed")][1]) == {-DEPTH}
+    assert set(lines[(0, "still water")][1]) == {0.0}
+
+
+TURN_OBLIQUE = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64, 0.6]])
+
+
+def test_a_gravity_vector_alone_puts_up_on_the_groups():
+    # no water, no seabed: the groups still carry up, and the profile draws heights along it
+    text = _scene(gravity=G_PLUS_X, waves=False).split("[water]")[0] + step("static", "s")
+    ds = catdae.run(catdae.load_case(text), progress=False)["s"].to_dataset()
+    np.testing.assert_array_equal(ds.attrs["up"], [-1.0, 0.0, 0.0])
+    assert "seabed_z" not in ds.attrs and "water_surface" not in ds.attrs
+    (_, ye), = [v for k, v in _lines(plot.profile(ds)).items() if k == (0, "c|None")]
+    np.testing.assert_allclose(ye, -ds.position.sel(node=plot.cable_paths(ds)["c"],
+                                                    axis="x").values, rtol=0, atol=0)
 
 
 def _parts(pvd):
