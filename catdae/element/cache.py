@@ -11,6 +11,18 @@ KERNEL_MODULES lists every module with numba kernels, as paths relative to the p
 (``element/catenary``): a new kernel module anywhere in catdae must be added (a test checks).
 Only numba's in-tree cache (each module's ``__pycache__``, used when the folder is writable)
 is handled; a read-only install is replaced whole on upgrade, which changes every stamp.
+
+Loading a cached kernel (:func:`load_lightly`): before the first one, numba "refreshes" its
+compiler, importing and registering the typing and lowering rules of everything it can compile
+(its string, list, dict, set, random, linear-algebra and datetime support, cffi, jitclass),
+about 0.06-0.1 s of CPU in every ``catdae run`` (benchmarks/startup.md), although a cached
+kernel is machine code that needs none of it. Only two parts of that refresh reach machine
+code: numba's runtime (NRT, the memory management of the arrays a kernel allocates, whose
+functions a kernel calls by name) and the hash secret symbols of ``numba.cpython.hashing``; the
+rest only serves compiling. So a cached kernel is loaded after those two; compiling (a kernel
+not in the cache, a call with new argument types) goes through numba's own path, which
+refreshes fully first. The machine code run is the same, so are the results (bit for bit:
+benchmarks/same_results.py).
 """
 
 from __future__ import annotations
@@ -23,6 +35,42 @@ KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
                   "element/fluid_kinematics", "element/grounded", "solvers/axial_damping",
                   "solvers/envelope")
 _STAMP = "catdae-kernels.sha256"
+_OWN = str(Path(__file__).resolve().parents[1])  # the catdae package folder
+
+
+def load_lightly() -> bool:
+    """Make numba load cached kernels without refreshing its compiler first (see above); True if
+    installed. Left as it is (False) when numba's loader is not the one this was written for
+    (numba 0.68: ``Cache.load_overload`` refreshes, then calls ``_load_overload``; its names
+    are checked). A load that fails the light way is retried the ordinary way. Only catdae's
+    own kernels (their cache under the package's folder) are loaded this way: any other numba
+    function in the process loads as numba loads it."""
+    from numba.core import caching
+    from numba.core.runtime import rtsys
+
+    cache = caching.Cache
+    real = cache.load_overload
+    if getattr(real, "_catdae_light", False):
+        return True
+    if real.__code__.co_names != ("refresh", "_guard_against_spurious_io_errors",
+                                  "_load_overload"):
+        return False
+
+    def load_overload(self, sig, target_context):
+        if not str(getattr(self, "_cache_path", "")).startswith(_OWN):
+            return real(self, sig, target_context)  # not a catdae kernel: numba's own way
+        try:
+            rtsys.initialize(target_context)  # NRT: its symbols, once per process
+            import numba.cpython.hashing  # noqa: F401  (its symbols)
+
+            with self._guard_against_spurious_io_errors():
+                return self._load_overload(sig, target_context)
+        except Exception:  # whatever the light way misses: numba's own way
+            return real(self, sig, target_context)
+
+    load_overload._catdae_light = True
+    cache.load_overload = load_overload
+    return True
 
 
 def sources_digest(root: Path) -> str:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from catdae.element.cache import load_lightly
 from catdae.element.catenary import (  # noqa: F401  (re-exported)
     CONVERGED,
     NOT_CONVERGED,
@@ -29,6 +30,8 @@ from catdae.element.mass import (  # noqa: F401  (re-exported)
     mass_batch,
     mass_gradient_batch,
 )
+
+load_lightly()  # cached kernels without numba's compiler set-up (catdae/element/cache.py)
 
 
 def sym_from_upper(f6: np.ndarray) -> np.ndarray:

@@ -77,3 +77,43 @@ def test_every_module_with_compiled_kernels_is_in_the_digest():
     with_kernels = {p.relative_to(root).with_suffix("").as_posix() for p in root.rglob("*.py")
                     if "@njit" in p.read_text()}
     assert with_kernels == set(KERNEL_MODULES)
+
+
+_LIGHT_PROBE = r"""
+import sys
+import numpy as np
+from catdae.element.elements import Elements
+from numba import njit
+# a taut, weightless element: h is EA (chord / L0 - 1) along the chord, whatever loaded it
+el = Elements(np.array([10.0]), np.array([1.0e6]), np.array([0.0]))
+st = el.solve(np.array([[6.0, 0.0, 8.0]]) * 1.001)
+light = "numba.np.arraymath" not in sys.modules  # numba's compiler rules never loaded
+@njit
+def twice(x):
+    return 2.0 * x
+import json
+print(json.dumps([light, twice(np.arange(3.0)).tolist(), st.h[0].tolist()]))
+"""
+
+
+def test_cached_kernels_load_without_numba_compiler_set_up_and_compiling_still_works():
+    """catdae/element/cache.py load_lightly: a cached kernel is loaded without numba's
+    compiler rules (which only compiling needs) and gives the exact answer; compiling a new
+    function afterwards still works (numba's own path sets the rules up). A fresh process, so
+    that nothing else has loaded them."""
+    import json
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, "-c", "from catdae.element.elements import Elements; "
+                    "import numpy as np; Elements(np.array([10.0]), np.array([1.0e6]), "
+                    "np.array([0.0])).solve(np.array([[6.0, 0.0, 8.0]]))"],
+                   check=True, capture_output=True, timeout=600)  # the cache filled
+    out = subprocess.run([sys.executable, "-c", _LIGHT_PROBE], check=True, capture_output=True,
+                         text=True, timeout=600).stdout
+    light, twice, h = json.loads(out)
+    assert light
+    assert twice == [0.0, 2.0, 4.0]
+    tension = 1.0e6 * (10.01 / 10.0 - 1.0)
+    assert abs(h[0] - 0.6 * tension) < 1e-6 * tension and abs(h[2] - 0.8 * tension) < 1e-6 * \
+        tension and h[1] == 0.0

@@ -266,6 +266,7 @@ from catdae.output.results import write_tree
 write_tree(tree, sys.argv[2])
 back = catdae.read_results(sys.argv[2])
 assert "dask.array" not in sys.modules, "a run imported dask.array"
+assert "dask" not in sys.modules, "a run imported dask"
 import dask.array as da
 from catdae._xr import xr
 lazy = xr.DataArray(da.ones(4, chunks=2), dims="x")
@@ -279,8 +280,9 @@ print("ok", float(back["tapped"].ds.time[-1]))
 
 def test_a_run_does_not_import_dask_and_dask_arrays_still_work(tmp_path):
     """xarray imports dask.array (0.7 s) on the first Variable it builds whenever dask is
-    installed; catdae answers xarray's question without the import (catdae/_xr.py). Checked in
-    a fresh process: a whole run, its netCDF write and read leave dask.array unimported, and
+    installed; catdae answers xarray's question without the import (catdae/_xr.py), and its
+    questions of the scheduler and of dask collections too. Checked in a fresh process: a
+    whole run, its netCDF write and read leave dask unimported (not even dask.base), and
     after it dask arrays are still dask arrays to xarray, masked ones still masked."""
     import subprocess
     import sys
