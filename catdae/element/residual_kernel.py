@@ -28,7 +28,7 @@ from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, w, ptr, ls, lf,
                   load_total, wl0, h, hw, use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm,
                   want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
-                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res):
+                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res, dm_skip):
     """r_q = q' - v and r_v = M v' + C v + g + F - P on the free dofs, into ``res`` (2n,).
 
     y = [q, v] and yp interleaved per unknown; unknown k is full dof ``fidx[k]``; the fixed
@@ -37,7 +37,10 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
     build the consistent mass, material damping and ∂M/∂c of the elements (times ``scale``:
     the consistent share of a blended mass); ``use_m``/``use_c``: use ``me``/``ce`` in the
     forces (given, when constant). ``m_diag`` and ``v_diag`` are the diagonal mass and the
-    diagonal damping (lumped parts, Rayleigh α M), ``p_nodal`` the nodal loads.
+    diagonal damping (lumped parts, Rayleigh α M), ``p_nodal`` the nodal loads. ``dm_skip``
+    (n_elements,): elements whose ∂M/∂c is left out (zero; their mass built without it): an
+    output's pass, whose forces are read at the supports only, skips it where an element
+    touches no supported dof; every residual IDA sees has none skipped.
 
     Returns False, with ``res`` untouched, where an element cannot be solved: the caller
     rejects the trial state.
@@ -74,7 +77,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
             done = False
             if want_dm:
                 fade = 0.0
-                if stat[e] == CONVERGED:
+                if stat[e] == CONVERGED and not dm_skip[e]:
                     fade = gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
                 if fade > 0.0:
                     done = mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,

@@ -15,6 +15,7 @@ import scipy.sparse as sp
 
 from catdae.case import Case
 from catdae.case.timefunc import TimeFunction
+from catdae.case.timefunc_compose import Scaled
 from catdae.element.elements import Elements, ElementState, PointLoads
 from catdae.model.connectors import build_connectors, extend, with_connectors
 from catdae.model.fluid import Fluid
@@ -113,6 +114,12 @@ class Model(MassMatrices):
         self._fixed_motions = [(int(k), tf) for k, (dof, tf) in zip(slots, self.motions,
                                                                       strict=True)
                                if k < self.fixed.size and self.fixed[k] == dof]
+        # a motion along a direction is one function scaled per axis: evaluated once per time
+        groups: dict[int, tuple] = {}
+        for k, tf in self._fixed_motions:
+            base, c = (tf.function, tf.factor) if isinstance(tf, Scaled) else (tf, None)
+            groups.setdefault(id(base), (base, []))[1].append((k, c))
+        self._motion_groups = list(groups.values())
         ld = self.loading
         self.elements = Elements(mesh.L0, mesh.EA, mesh.w,
                                  PointLoads(ld.internal_ptr, ld.internal_s,
@@ -149,8 +156,13 @@ class Model(MassMatrices):
         """Prescribed displacement, velocity and acceleration of the fixed dofs, (n_fixed,)."""
         nf = self.fixed.size
         u, v, a = np.zeros(nf), np.zeros(nf), np.zeros(nf)
-        for k, tf in self._fixed_motions:
-            u[k], v[k], a[k] = tf.evaluate(t)
+        for tf, slots in self._motion_groups:
+            f, df, d2f = tf.evaluate(t)
+            for k, c in slots:  # c: the axis' factor of a motion along a direction
+                if c is None:
+                    u[k], v[k], a[k] = f, df, d2f
+                else:
+                    u[k], v[k], a[k] = c * f, c * df, c * d2f
         return u, v, a
 
     def breakpoints(self, t0: float, t1: float, rel: float = 1e-10) -> list[tuple[float, float]]:

@@ -28,13 +28,40 @@ CARRY = 1e-4  # largest relative change of an end force carried to first order
 
 @njit(cache=True)
 def carried_tensions(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf,
-                     load_total, cd, g, chord, out):
+                     load_total, cd, g, chord, out, carry, t, first, ext, ext_time):
     """End tensions (n, 2) at the state y (positions and velocities of the unknowns in
     ``fidx``, interleaved; fixed dofs at ``xp``/``vp``) from the end forces ``hb`` and
     stiffnesses ``kb`` solved at positions ``xb``: h = hb + kb (c - c_b) where the change
     |kb (c - c_b)| is below ``CARRY`` |hb|, else the element is solved again (warm-started from
     hb). Plus the viscous tension cd ė, ė = g·ċ (cd zero without axial damping; g taken again
-    where solved again; ``chord``: the unit chord). Returns the elements solved (-1: one failed)."""
+    where solved again; ``chord``: the unit chord). Returns the elements solved (-1: one failed).
+
+    Then the tensions ``out`` at time t are taken into the envelope ``ext`` (2, n, 2: largest,
+    smallest) and ``ext_time`` (when; all of ``out`` where ``first``). With ``carry`` False the
+    tensions are not computed: ``out`` holds them (an output's), only the envelope is updated."""
+    if carry:
+        solved = _carry(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf,
+                        load_total, cd, g, chord, out)
+        if solved < 0:
+            return solved
+    else:
+        solved = 0
+    for e in range(out.shape[0]):
+        for k in range(2):
+            v = out[e, k]
+            if first or v > ext[0, e, k]:
+                ext[0, e, k] = v
+                ext_time[0, e, k] = t
+            if first or v < ext[1, e, k]:
+                ext[1, e, k] = v
+                ext_time[1, e, k] = t
+    return solved
+
+
+@njit(cache=True)
+def _carry(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf, load_total, cd, g,
+           chord, out):
+    """The carried tensions of ``carried_tensions`` into ``out``; the elements solved again."""
     X = xb.copy()
     V = np.zeros(xb.shape[0])
     for k in range(fidx.shape[0]):
@@ -95,10 +122,10 @@ class TensionEnvelope:
         self.prob = prob
         m = prob.model
         ne = m.mesh.n_elements
-        self.t_max = np.full((ne, 2), np.nan)
-        self.t_min = np.full((ne, 2), np.nan)
-        self.time_max = np.full((ne, 2), np.nan)
-        self.time_min = np.full((ne, 2), np.nan)
+        self._ext = np.full((2, ne, 2), np.nan)  # largest, smallest
+        self._ext_time = np.full((2, ne, 2), np.nan)  # when
+        self.t_max, self.t_min = self._ext
+        self.time_max, self.time_min = self._ext_time
         self._h = None if prob.h is None else np.array(prob.h, float, copy=True)
         self._X = np.zeros(m.n_dof)
         self._chord = np.zeros((ne, 3))
@@ -113,25 +140,20 @@ class TensionEnvelope:
         self._zero_cd = np.zeros(ne)
         self._zero_g = np.zeros((ne, 3))
 
-    def carried(self, t: float, y: np.ndarray) -> np.ndarray | None:
-        """End tensions of y at t carried from the last residual evaluation when it was at
-        time t (the step's last Newton iterate), else None."""
+    def _take(self, t: float, y, carry: bool, out: np.ndarray) -> int:
+        """One compiled pass (``carried_tensions``): the tensions carried from the last
+        residual evaluation into ``out`` when ``carry``, and ``out`` into the envelope; the
+        elements solved again, -1 where one failed (the envelope then unchanged)."""
         prob = self.prob
-        at = prob._buffers_at
-        if at is None or at[0] != t:
-            return None
         xp, vp, _ = prob._supports(t)
         ax = prob.axial
         cd, g = (ax.cd, ax.g) if ax is not None else (self._zero_cd, self._zero_g)
         chord = ax is not None and ax.chord
         el = prob.model.elements
-        solved = carried_tensions(y, prob._fidx, prob._fixed, xp, vp, prob._conn, prob._Xb,
-                                  prob._hw, prob._kmat, el.L0, el.EA, el.w, el._ptr, el._ls,
-                                  el._lf, el._load_total, cd, g, chord, self._out)
-        if solved < 0:
-            return None
-        self.n_elements_solved += solved
-        return self._out
+        return carried_tensions(y, prob._fidx, prob._fixed, xp, vp, prob._conn, prob._Xb,
+                                prob._hw, prob._kmat, el.L0, el.EA, el.w, el._ptr, el._ls,
+                                el._lf, el._load_total, cd, g, chord, out, carry, t,
+                                self.n_updates == 0, self._ext, self._ext_time)
 
     def tensions(self, t: float, y: np.ndarray) -> np.ndarray | None:
         """End tensions (n, 2) of the state y at t, None where an element cannot be solved."""
@@ -164,19 +186,21 @@ class TensionEnvelope:
 
     def update(self, t: float, y: np.ndarray | None = None,
                tension: np.ndarray | None = None) -> None:
-        """Take the state y at t (or its tensions, when known) into the envelope."""
+        """Take the state y at t (or its tensions, when known) into the envelope: the
+        tensions carried from the step's last Newton iterate when the buffers hold a state of
+        this time, else solved afresh."""
         if tension is None:
-            tension = self.carried(t, y)
-        if tension is None:
+            at = self.prob._buffers_at
+            if at is not None and at[0] == t:
+                solved = self._take(t, y, True, self._out)
+                if solved >= 0:
+                    self.n_elements_solved += solved
+                    self.n_updates += 1
+                    return
             self.n_solved += 1
             tension = self.tensions(t, y)
             if tension is None:
                 return
+        # y is unused without the carry: any 1-D float array
+        self._take(t, self._X, False, np.ascontiguousarray(tension, float))
         self.n_updates += 1
-        first = self.n_updates == 1
-        up = first | (tension > self.t_max)
-        self.t_max[up] = tension[up]
-        self.time_max[up] = t
-        dn = first | (tension < self.t_min)
-        self.t_min[dn] = tension[dn]
-        self.time_min[dn] = t

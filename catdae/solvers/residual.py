@@ -126,6 +126,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self._ce = (m.linear_element_mass(damping=True) if mm.linear and self.material else
                     np.zeros((ne, 6, 6)) if self._want_c else self._dummy3)
         self._dm = np.zeros((ne, 3, 6, 6)) if self._want_dm else self._dummy4
+        self._dm_skip_none = np.zeros(ne, np.bool_)
+        # an output reads the forces at the supports only (reactions)
+        self._dm_skip_output = ~np.isin(m.edofs, m.fixed).any(axis=1)
         self._fflat = np.zeros((ne, 6))
         self._kmat = np.zeros((ne, 3, 3))
         self._its = np.zeros(ne, np.int64)
@@ -150,10 +153,14 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self._conn = np.ascontiguousarray(m.mesh.conn, np.int64)
         self._edofs = np.ascontiguousarray(m.edofs, np.int64)
 
-    def evaluate(self, t: float, y: np.ndarray, yp: np.ndarray, res: np.ndarray) -> bool:
+    def evaluate(self, t: float, y: np.ndarray, yp: np.ndarray, res: np.ndarray,
+                 output: bool = False) -> bool:
         """The residual at (t, y, yp) into ``res`` in one compiled pass; False (res untouched)
         where an element cannot be solved. The element state stays in the buffers for the
-        iteration matrix and the outputs at the same (t, q)."""
+        iteration matrix and the outputs at the same (t, q). ``output``: for ``observe``,
+        which reads the forces at the supports only: ∂M/∂c (the Lagrange terms) only of the
+        elements that touch a supported dof, and the buffers not offered to the iteration
+        matrix or the envelope afterwards."""
         m = self.model
         xp, vp, ap = self._supports(t)
         m.set_time(t)
@@ -167,7 +174,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
             m.gauss_s, m.gauss_w, m.mesh.m, m.mesh.c, *self._pm, self._want_m,
             self._use_m, self._want_c, self._use_c, self._want_dm, self._scale, self.alpha,
             self.beta, self.m_diag, self._v_diag, p, self._fflat, self._kmat, self._its,
-            self._stat, self._me, self._ce, self._dm, self._force, res)
+            self._stat, self._me, self._ce, self._dm, self._force, res,
+            self._dm_skip_output if output else self._dm_skip_none)
         if not ok:
             self._buffers_at = None
             return False
@@ -177,7 +185,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
             self._add_connector_force(res)
         self.h = self._hw.copy()
         self.X[:] = self._Xb
-        self._buffers_at = (t, np.array(y[0::2], copy=True))
+        self._buffers_at = None if output else (t, np.array(y[0::2], copy=True))
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
         if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §17)
@@ -287,7 +295,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         m = self.model
         # read-only views, as IDA passes them: one compiled signature of the pass, not two
         y, yp = _readonly(y), _readonly(yp)
-        if not self.evaluate(t, y, yp, self._res_scratch):
+        if not self.evaluate(t, y, yp, self._res_scratch, output=True):
             raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
                               termination="element failure")
         h = self.h  # a copy of the buffer, made by evaluate

@@ -56,6 +56,12 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
     return "sparse"
 
 
+def _last(a: np.ndarray) -> np.ndarray:
+    """The last state of an IDA result's ``y`` or ``yp`` (1-D in one-step and single-time
+    calls; the last row where a version returns them as rows)."""
+    return a if a.ndim == 1 else a[-1]
+
+
 def output_times(t0: float, duration: float, dt_out: float) -> np.ndarray:
     """t0, t0 + dt, ... and the end exactly (the next step starts there)."""
     t_end = t0 + duration
@@ -235,13 +241,14 @@ class _Run:
             if not res.success:
                 self.status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
                 return
-            t_new = float(np.atleast_1d(res.t)[-1])
+            t_new = res.t if type(res.t) is float else float(np.atleast_1d(res.t)[-1])
+            y_last, yp_last = _last(res.y), _last(res.yp)
             # after an output interpolated inside the last step, IDA's next one-step call
             # returns that step's end again without stepping: nothing new for the work
             advanced = t_new > t_int
             if advanced:
                 self.n_steps += 1
-                self.outputs.envelope.update(t_new, np.atleast_2d(res.y)[-1])
+                self.outputs.envelope.update(t_new, y_last)
             # IDA's max_num_steps counts per call; in one-step mode guard the step size
             # ourselves: steps that no longer advance time mean the integration is stuck
             small = t_new - t_int <= STALL_STEP * max(abs(t_new), self.dt_out)
@@ -251,7 +258,6 @@ class _Run:
                 self.status = (f"step size collapsed at t = {t_int:.6g} s (IDA could not "
                                f"advance; {prob.n_rejected} trial states rejected)")
                 return
-            y_last, yp_last = np.atleast_2d(res.y)[-1], np.atleast_2d(res.yp)[-1]
             at_stop = ((t_stop < t_end or end_jump)
                        and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0))
             self._record_passed(solver, t_int, y_last, yp_last, at_stop)
@@ -303,6 +309,6 @@ class _Run:
                 yk, ypk = y_last, yp_last
             else:
                 ri = solver.step(tk, method="normal")
-                yk, ypk = np.atleast_2d(ri.y)[-1], np.atleast_2d(ri.yp)[-1]
+                yk, ypk = _last(ri.y), _last(ri.yp)
             self.outputs.record(self.k_done, tk, yk, ypk)
             self.k_done += 1
