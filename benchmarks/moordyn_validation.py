@@ -20,7 +20,10 @@ scenes only (each also by MoorDyn with EI = 0, the line catdae models). ``--long
 scene that long instead (the chain's heave continued as the sine its record samples, the jumper's
 motion or waves going on), catdae at the settings that passed and MoorDyn at its largest step
 within tolerance, for the cost per simulated second once start-up no longer counts; the error is
-still the published window's.
+still the published window's. For the chain the note also gives the marginal cost, (cost of the
+long run - cost of the published 30 s) / (SECONDS - 30 s), each code's start-up taken out.
+``--scenes chain`` or ``--scenes jumper`` runs only those scenes (default: both); ``--repeat N``
+gives the long chain runs' median cost of N runs of each code (the machine's load varies).
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from moordyn_scenes import (  # noqa: E402
     DATA,
     JUMPER_AMPLITUDE,
     JUMPER_PERIOD,
+    RECORD,
     WAVE_CASES,
     WAVE_PERIOD,
     chain_metric,
@@ -56,6 +60,9 @@ import catdae  # noqa: E402
 from catdae.case import load_case  # noqa: E402
 
 CHAIN_TOL = 0.15
+# the chain's (elements, rtol) ladders: short runs, and long runs (rungs that passed)
+CHAIN_SHORT = ((10, 1e-3), (20, 1e-2), (20, 6e-3), (20, 3e-3), (20, 1e-3))
+CHAIN_LONG = ((20, 1e-2), (20, 6e-3), (20, 3e-3))
 JUMPER_TOL = 1.5e3  # N
 # catdae's jumper settings: the short runs' ladder, and the long runs' (those that passed)
 JUMPER_LADDER = ((20, 1e-4), (20, 3e-5), (40, 1e-4), (40, 3e-5))
@@ -74,6 +81,11 @@ def catdae_chain(depth, motion, elements, rtol, duration=None):
     dur = float(ds.time.values[-1] - ds.time.values[0])
     return chain_metric(ds.time.values, t, depth, motion, static), cpu / dur, wall / dur, \
         int(ds.attrs["n_steps"])
+
+
+def _marginal(cost_long, seconds, cost_short, short=RECORD):
+    """CPU s per simulated s between the published window's end and the long run's."""
+    return (cost_long * seconds - cost_short * short) / (seconds - short)
 
 
 def catdae_jumper(case, elements, rtol, duration=None):
@@ -238,25 +250,35 @@ def moordyn_ladder(run, dtm0, n=4):
 
 
 # ---------------------------------------------------------------------------------- long runs
-def long_runs(md, seconds, quick=False, jumper_only=False):
+def long_runs(md, seconds, quick=False, scenes=("chain", "jumper"), repeat=1):
     """Each scene run for ``seconds`` of motion (the chain's heave continued as its sine, the
     jumper's top motion or waves going on): catdae at the settings that passed on the short
     runs, MoorDyn at its largest step within tolerance. Error on the published window."""
     rows = []
     chains = [(200, "ZZP1_A1")] if quick else [
         (200, "ZZP1_A1"), (200, "ZZP1_A2"), (600, "ZZP1_A1"), (600, "ZZP1_A2")]
-    if jumper_only:
-        chains = []
-    for depth, motion in chains:
+    for depth, motion in (chains if "chain" in scenes else []):
         scene = f"chain {depth} m, {motion}, {seconds:g} s"
-        for elements, rtol in ((20, 3e-3), (20, 1e-3)):
-            err, cpu, wall, steps = catdae_chain(depth, motion, elements, rtol, seconds)
+        for elements, rtol in CHAIN_LONG:
+            runs = [catdae_chain(depth, motion, elements, rtol, seconds) for _ in range(repeat)]
+            err, steps = runs[0][0], runs[0][3]
+            cpu, wall = (float(np.median([r[k] for r in runs])) for k in (1, 2))
+            short = np.median([catdae_chain(depth, motion, elements, rtol)[1]
+                               for _ in range(repeat)])
             rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err, CHAIN_TOL, cpu,
-                         wall, f"{steps} steps"))
-        with tempfile.TemporaryDirectory() as d:
-            err, cpu, wall = moordyn_chain(md, depth, motion, 0.003, Path(d), seconds)
-        rows.append((scene, "MoorDyn 76 segs, dtM 0.003 s", err, CHAIN_TOL, cpu, wall, "RK2"))
-    for case in ([2] if quick else [2, 3, 4, 5, 6]):
+                         wall, f"{steps} steps; marginal "
+                         f"{_marginal(cpu, seconds, short):.4g}"))
+        runs, shorts = [], []
+        for _ in range(repeat):
+            with tempfile.TemporaryDirectory() as d:
+                runs.append(moordyn_chain(md, depth, motion, 0.003, Path(d), seconds))
+            with tempfile.TemporaryDirectory() as d:
+                shorts.append(moordyn_chain(md, depth, motion, 0.003, Path(d), RECORD)[1])
+        err = runs[0][0]
+        cpu, wall = (float(np.median([r[k] for r in runs])) for k in (1, 2))
+        rows.append((scene, "MoorDyn 76 segs, dtM 0.003 s", err, CHAIN_TOL, cpu, wall,
+                     f"RK2; marginal {_marginal(cpu, seconds, np.median(shorts)):.4g}"))
+    for case in ([] if "jumper" not in scenes else [2] if quick else [2, 3, 4, 5, 6]):
         scene = f"jumper case {case}, {seconds:g} s"
         for elements, rtol in JUMPER_LONG:
             err, cpu, wall, steps = catdae_jumper(case, elements, rtol, seconds)
@@ -275,28 +297,36 @@ def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", default=None)
-    ap.add_argument("--jumper", action="store_true", help="the jumper's scenes only")
+    ap.add_argument("--jumper", action="store_true",
+                    help="the jumper's scenes only (as --scenes jumper)")
     ap.add_argument("--long", type=float, default=None,
                     help="seconds of motion: run each scene this long instead (cost of long runs)")
+    ap.add_argument("--scenes", default="chain,jumper",
+                    help="which scenes: chain, jumper or both (comma-separated)")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="long chain runs: median cost of this many runs of each code")
     args = ap.parse_args(argv)
+    scenes = ("jumper",) if args.jumper else tuple(x.strip() for x in args.scenes.split(","))
+    if not set(scenes) <= {"chain", "jumper"}:
+        ap.error(f"--scenes: expected chain and/or jumper, got {args.scenes!r}")
     import moordyn as md
     from transient_speed import machine
 
     chains = [(200, "ZZP1_A1")] if args.quick else [
         (200, "ZZP1_A1"), (200, "ZZP1_A2"), (600, "ZZP1_A1"), (600, "ZZP1_A2")]
     jumpers = [2] if args.quick else [2, 3, 4, 5, 6]
-    if args.jumper:
-        chains = []
+    chains = chains if "chain" in scenes else []
+    jumpers = jumpers if "jumper" in scenes else []
     rows = []
     # warm the kernels (compiled once per source change; not part of any cost)
     catdae.run(load_case(chain_toml(200, motion="ZZP1_A1", elements=4, rtol=1e-2,
                                     duration=0.5)), progress=False)
     if args.long is not None:
         chains, jumpers = [], []
-        rows = long_runs(md, args.long, args.quick, args.jumper)
+        rows = long_runs(md, args.long, args.quick, scenes, args.repeat)
     for depth, motion in chains:
         scene = f"chain {depth} m, {motion}"
-        for elements, rtol in ((10, 1e-3), (20, 3e-3), (20, 1e-3)):
+        for elements, rtol in CHAIN_SHORT:
             err, cpu, wall, steps = catdae_chain(depth, motion, elements, rtol)
             rows.append((scene, f"catdae {elements} el., rtol {rtol:g}", err, CHAIN_TOL,
                          cpu, wall, f"{steps} steps"))

@@ -56,7 +56,7 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         **overrides) -> xr.DataTree:
     """Run every step of a case and return an ``xarray.DataTree`` with one group per step.
 
-    ``overrides`` (rtol, atol, elements, mass_model) replace the case's values. With
+    ``overrides`` (rtol, atol, elements, mass_model, max_order) replace the case's values. With
     ``output`` the tree is also written to netCDF-4; long transient steps write it in
     increments as they go. On failure a CatdaeError is raised whose ``partial`` attribute
     holds the tree computed so far (status says why); with ``output`` that partial tree is

@@ -36,6 +36,17 @@ def default_case_path() -> Path:
     return Path(str(files("catdae") / "data" / DEFAULT_CASE))
 
 
+def _order(text: str) -> int | str:
+    """``--max-order``: "auto" or an integer (its range is judged with the case's own field)."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'expected "auto" or an integer 1-5, got {text!r}') \
+            from None
+
+
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="catdae", description="Exact elastic catenary cable "
                                 "analysis: statics, modes and nonlinear dynamics.")
@@ -47,6 +58,9 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--rtol", type=float, help="relative tolerance of transient steps")
     r.add_argument("--atol", type=float, help="absolute tolerance of transient steps, m")
     r.add_argument("--elements", type=int, help="elements per cable")
+    r.add_argument("--max-order", type=_order, metavar="{auto,1,2,3,4,5}",
+                   help="largest BDF order of transient steps (2: A-stable, damps what it does "
+                        "not resolve)")
     r.add_argument("--mass-model", choices=MASS_MODEL_NAMES,
                    help="mass model of every transient and modal step")
     r.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
@@ -163,7 +177,8 @@ def _run(args) -> int:
     try:
         with announce_compiling():  # whenever numba compiles, the first time is announced
             tree = run(case, output=out, progress=args.progress, rtol=args.rtol,
-                       atol=args.atol, elements=args.elements, mass_model=args.mass_model)
+                       atol=args.atol, elements=args.elements, mass_model=args.mass_model,
+                       max_order=args.max_order)
     except CaseError:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:

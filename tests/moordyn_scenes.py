@@ -17,6 +17,17 @@ drive and the metrics its test programs.
   2``): without axial damping the order race of ``"auto"`` picked order 5 on a window of the 2 m
   record, which then resolved the undamped axial ringing of the top element (the 200 m record
   at rtol 1e-3: 5539 steps and 0.25 against 1321 steps and 0.096 at order 2).
+- Seabed friction: the inputs give MoorDyn's FrictionCoefficient 0.5 and leave its FricDamp
+  at 200 N s/m: MoorDyn's friction on a node is min(μ 200 N s/m |u|, μ N), linear in the speed
+  up to N / 200 N s/m, about 166 m/s for its 10 m segments (N ≈ 33 kN): in these scenes a
+  100 N s/m damper per node, practically none. catdae's smoothed Coulomb law reaches μ N
+  above ``friction_velocity``; the scenes set it to 0.1 m/s (``CHAIN_FRICTION_VELOCITY``),
+  chosen by measurement: at 76 elements, rtol 1e-4, the 5 m records' fairlead tension
+  differs from the near-Coulomb 0.001 m/s by at most 2.4 % (200 m) and 1.9 % (600 m) of the
+  metric's scale (2 max |ΔT_ref|); 0.01 m/s, the default, 1.0 %; frictionless 5.2 %. At 20
+  elements friction matters more (the 200 m, 5 m record frictionless is 0.206, outside the
+  tolerance; with friction 0.10-0.11), and 0.1 m/s takes 40 % fewer steps than 0.01 m/s: the
+  stick-slip turns of each lying node are spread over a 10 times wider band of speeds.
 - MoorDyn's inputs damp the axial strain rate, BA/-zeta = -1.0 for the chain and -0.5 for the
   jumper: a viscous force c_d ė on each segment's elongation rate ė with c_d = ζ sqrt(EA m)
   (MoorDyn's log: "damping set to 8.08e6 N s based on input of -1" for the chain's BA =
@@ -60,6 +71,11 @@ JUMPER_PERIOD = 27.0
 JUMPER_AMPLITUDE = 10.0
 WAVE_PERIOD = 10.0
 CHAIN_ZETA = 1.0  # MoorDyn's BA/-zeta -1.0 (see the module docstring)
+# m/s: the chain's friction velocity scale (see the module docstring): MoorDyn's own friction
+# with these inputs is linear to far above any speed here; 0.1 m/s changes the fairlead tension
+# by at most 2.4 % of the metric's scale against 0.001 m/s (76 elements, rtol 1e-4) and takes
+# 40 % fewer steps than 0.01 m/s at 20 elements (benchmarks/moordyn_validation.md)
+CHAIN_FRICTION_VELOCITY = 0.1
 JUMPER_ZETA = 0.5  # MoorDyn's BA/-zeta -0.5
 WAVE_CASES = {4: (230.0, 0.0), 5: (165.0, 45.0), 6: (0.0, 90.0)}  # phase, heading (deg)
 
@@ -89,12 +105,14 @@ def _inline(t: np.ndarray, v: np.ndarray) -> str:
 def chain_toml(depth: int, *, elements: int = 20, motion: str | None = None,
                rigid: bool = False, duration: float | None = None, rtol: float = 1e-4,
                output_interval: float = 0.1, mass_model: str = "lumped",
-               max_order: str | int = 2, axial_damping: float | None = CHAIN_ZETA) -> str:
+               max_order: str | int = 2, axial_damping: float | None = CHAIN_ZETA,
+               friction_velocity: float = CHAIN_FRICTION_VELOCITY) -> str:
     """The chain at ``depth`` (200 or 600 m). ``motion`` "ZZP1_A1" or "ZZP1_A2" adds the
     fairlead heave record and a transient step of ``duration`` (default: the record)."""
     x, length, _, _ = CHAIN[depth]
     seabed = ("" if rigid else
-              "stiffness = 1.0e5\ndamping = 1.0e4\nfriction = 0.5\n")
+              "stiffness = 1.0e5\ndamping = 1.0e4\nfriction = 0.5\n"
+              f"friction_velocity = {friction_velocity!r}\n")
     text = f"""
 title = "MoorDyn/OrcaFlex quasi-static chain, {depth} m"
 gravity = 9.81

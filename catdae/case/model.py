@@ -338,11 +338,12 @@ class Case:
         return self.materials[c.material]
 
     def with_overrides(self, rtol: float | None = None, atol: float | None = None,
-                       elements: int | None = None, mass_model: str | None = None) -> Case:
-        """A new Case with ``rtol``/``atol`` on every transient step, ``mass_model`` on every
-        transient and modal step and ``elements`` on every cable (``None`` leaves a setting
-        as it is); see :func:`catdae.case.overrides.with_overrides`."""
+                       elements: int | None = None, mass_model: str | None = None,
+                       max_order: int | str | None = None) -> Case:
+        """A new Case with ``rtol``/``atol``/``max_order`` on every transient step,
+        ``mass_model`` on every transient and modal step and ``elements`` on every cable
+        (``None`` leaves a setting as it is); see :func:`catdae.case.overrides.with_overrides`."""
         from catdae.case.overrides import with_overrides
 
         return with_overrides(self, rtol=rtol, atol=atol, elements=elements,
-                              mass_model=mass_model)
+                              mass_model=mass_model, max_order=max_order)

@@ -1,6 +1,7 @@
 """Settings a command line (or ``catdae.run``'s keywords) replaces in a case: ``rtol``,
-``atol``, ``mass_model`` and ``elements``, validated by the case file's own schema types
-(``schema.OverridesSchema``), with what sits on mesh nodes kept in place on a new mesh."""
+``atol``, ``max_order``, ``mass_model`` and ``elements``, validated by the case file's own
+schema types (``schema.OverridesSchema``), with what sits on mesh nodes kept in place on a new
+mesh."""
 
 from __future__ import annotations
 
@@ -18,8 +19,9 @@ from catdae.errors import CaseError
 
 
 def with_overrides(self: Case, rtol: float | None = None, atol: float | None = None,
-                   elements: int | None = None, mass_model: str | None = None) -> Case:
-    """A new Case with ``rtol``/``atol`` set on every transient step, ``mass_model``
+                   elements: int | None = None, mass_model: str | None = None,
+                   max_order: int | str | None = None) -> Case:
+    """A new Case with ``rtol``/``atol``/``max_order`` set on every transient step, ``mass_model``
     (one of ``schema.MASS_MODEL_NAMES``) on every transient and modal step, and ``elements`` on
     every cable (``None`` leaves a setting as it is).
 
@@ -27,7 +29,7 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
     kept at the same place on the cable (its unstrained arc length in the case's mesh).
     Raises ``CaseError`` if a value is invalid.
     """
-    given = {"rtol": rtol, "atol": atol, "mass_model": mass_model,
+    given = {"rtol": rtol, "atol": atol, "mass_model": mass_model, "max_order": max_order,
              "elements": (int(elements) if isinstance(elements, numbers.Integral)
                           and not isinstance(elements, bool) else elements)}
     try:
@@ -38,7 +40,8 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
                                     for err in exc.errors()]) from None
     steps = tuple(
         replace(s, rtol=float(rtol if rtol is not None else s.rtol),
-                atol=float(atol if atol is not None else s.atol))
+                atol=float(atol if atol is not None else s.atol),
+                max_order=max_order if max_order is not None else s.max_order)
         if s.kind == "transient" else s
         for s in self.steps
     )

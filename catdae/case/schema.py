@@ -24,6 +24,7 @@ Name = Annotated[str, Field(min_length=1)]
 # settings a command line may override too (``OverridesSchema``): one type for both
 Elements = Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)]
 MassModelName = Literal["auto", "blended", "consistent", "lumped", "linear"]
+MaxOrder = Literal["auto"] | Annotated[int, Field(ge=1, le=5)]  # IDA's BDF order cap
 MASS_MODEL_NAMES = get_args(MassModelName)
 TomlTable = dict[str, Any]  # validated later on its own (time functions, damping)
 
@@ -279,11 +280,12 @@ POSITION = TypeAdapter(Annotated[list[Coordinate], Field(min_length=3, max_lengt
 
 
 class OverridesSchema(BaseModel):
-    """What ``catdae run --rtol/--atol/--elements/--mass-model`` (and the keywords of
-    ``catdae.run``) may replace, typed as the case file's own fields."""
+    """What ``catdae run --rtol/--atol/--elements/--mass-model/--max-order`` (and the keywords
+    of ``catdae.run``) may replace, typed as the case file's own fields."""
 
     model_config = STRICT
     rtol: Pos | None = None  # as a transient step's rtol
     atol: Pos | None = None  # as a transient step's atol
     elements: Elements | None = None  # as a cable's elements
     mass_model: MassModelName | None = None  # as a modal or transient step's mass_model
+    max_order: MaxOrder | None = None  # as a transient step's max_order

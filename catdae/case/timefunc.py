@@ -19,6 +19,7 @@ case file is ever evaluated as code.
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, ClassVar
 
@@ -199,6 +200,8 @@ class Table(TimeFunction):
     file: str | None = None
     kind: ClassVar[str] = "table"
     _spline: CubicSpline = field(init=False, repr=False, compare=False, hash=False)
+    _knots: list = field(init=False, repr=False, compare=False, hash=False)
+    _cubics: list = field(init=False, repr=False, compare=False, hash=False)
 
     def __post_init__(self):
         from scipy.interpolate import CubicSpline  # lazy: only for tables
@@ -207,8 +210,24 @@ class Table(TimeFunction):
                              bc_type="not-a-knot")
         # A cache derived from the frozen fields, set once here and never changed.
         object.__setattr__(self, "_spline", spline)
+        # one time (every residual): the same cubics in Python floats, found by bisection,
+        # not three scipy calls (40 µs a time on a 3000-point heave record)
+        object.__setattr__(self, "_knots", [float(x) for x in spline.x])
+        object.__setattr__(self, "_cubics", [tuple(map(float, c)) for c in spline.c.T])
 
     def _evaluate(self, t):
+        if isinstance(t, float):
+            x = self._knots
+            if t >= x[-1] or t < x[0]:  # held at the end values, at rest
+                i = 0 if t < x[0] else len(x) - 2
+                s = 0.0 if t < x[0] else x[-1] - x[-2]
+                a, b, c, d = self._cubics[i]
+                return ((a * s + b) * s + c) * s + d, 0.0, 0.0
+            i = bisect_right(x, t) - 1
+            s = t - x[i]
+            a, b, c, d = self._cubics[i]
+            return (((a * s + b) * s + c) * s + d, (3.0 * a * s + 2.0 * b) * s + c,
+                    6.0 * a * s + 2.0 * b)
         t0, t1 = self.t[0], self.t[-1]
         tc = np.clip(t, t0, t1)
         inside = (t >= t0) & (t < t1)

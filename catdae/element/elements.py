@@ -153,6 +153,14 @@ class Elements:
         return np.ascontiguousarray(s)
 
     def _h(self, h) -> np.ndarray:
+        """h as a read-only C-contiguous (n, 3) float array (one h broadcast to every element
+        if given as (3,)); an array already so shaped is viewed, not broadcast (a view is all
+        the kernels need: the outputs and the envelope ask at every step)."""
+        if (type(h) is np.ndarray and h.dtype == np.float64 and h.shape == (self.n, 3)
+                and h.flags.c_contiguous):
+            v = h.view()
+            v.flags.writeable = False
+            return v
         return np.ascontiguousarray(np.broadcast_to(np.asarray(h, float), (self.n, 3)))
 
     def solve(self, chord, h0=None, *, tol: float = 1e-12, max_iter: int = 100) -> ElementState:

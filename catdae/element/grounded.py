@@ -276,3 +276,74 @@ def position_batch(h, w, ea, l0, mode, s, out):
         for j in range(s.shape[1]):
             _position_one(h[e, 0], h[e, 1], h[e, 2], w[e], ea[e], l0[e], mode[e], s[e, j],
                           out[e, j], f)
+
+
+# --------------------------------------------------------------------------------------------
+# The seabed's penalty contact at the nodes (catdae.model.seabed.SeabedContact; §17.5)
+@njit(cache=True)
+def contact_forces(X, V, nodes, nb_a, nb_b, area, zb, k, c, mu_a, mu_l, vs, use_v, out):
+    """Force of the seabed on each contact node below z_b, into ``out`` (n_nodes, 3), which
+    holds zeros there: N = a k δ up, -a c ż with the velocities, and the smoothed Coulomb
+    friction -N M u / sqrt(|u|² + v_s²), M = μ_a ê êᵀ + μ_l (I - ê êᵀ) on the horizontal
+    velocity u, ê the horizontal direction of the chord through the node's neighbours."""
+    friction = use_v and (mu_a > 0.0 or mu_l > 0.0)
+    for p in range(nodes.shape[0]):
+        i = nodes[p]
+        delta = zb - X[i, 2]
+        if delta <= 0.0:
+            continue
+        n = area[p] * k * delta
+        fz = n
+        if use_v:
+            fz -= area[p] * c * V[i, 2]
+        out[i, 2] = fz
+        if friction:
+            ux, uy = V[i, 0], V[i, 1]
+            ex = X[nb_b[p], 0] - X[nb_a[p], 0]
+            ey = X[nb_b[p], 1] - X[nb_a[p], 1]
+            en = np.sqrt(ex * ex + ey * ey)
+            if en > 0.0:
+                ex /= en
+                ey /= en
+            ua = ux * ex + uy * ey
+            g = n / np.sqrt(ux * ux + uy * uy + vs * vs)
+            out[i, 0] = -g * (mu_l * ux + (mu_a - mu_l) * ua * ex)
+            out[i, 1] = -g * (mu_l * uy + (mu_a - mu_l) * ua * ey)
+
+
+@njit(cache=True)
+def contact_derivatives(X, V, nodes, nb_a, nb_b, area, zb, k, c, mu_a, mu_l, vs, use_v, kq, kv):
+    """-∂F/∂q and -∂F/∂v of ``contact_forces`` as (p, 3, 3) blocks into kq, kv (zeros on
+    entry), ê held fixed: -∂F_z/∂z = a k, -∂F_z/∂ż = a c, -∂F_h/∂z = -a k M u / S and
+    -∂F_h/∂u = (N/S) (M - M u uᵀ/S²), S = sqrt(|u|² + v_s²)."""
+    friction = use_v and (mu_a > 0.0 or mu_l > 0.0)
+    for p in range(nodes.shape[0]):
+        i = nodes[p]
+        delta = zb - X[i, 2]
+        if delta <= 0.0:
+            continue
+        ak = area[p] * k
+        kq[p, 2, 2] = ak
+        if use_v:
+            kv[p, 2, 2] = area[p] * c
+        if friction:
+            ux, uy = V[i, 0], V[i, 1]
+            ex = X[nb_b[p], 0] - X[nb_a[p], 0]
+            ey = X[nb_b[p], 1] - X[nb_a[p], 1]
+            en = np.sqrt(ex * ex + ey * ey)
+            if en > 0.0:
+                ex /= en
+                ey /= en
+            dm = mu_a - mu_l
+            ua = ux * ex + uy * ey
+            mx = mu_l * ux + dm * ua * ex
+            my = mu_l * uy + dm * ua * ey
+            s = np.sqrt(ux * ux + uy * uy + vs * vs)
+            kq[p, 0, 2] = -(ak / s) * mx
+            kq[p, 1, 2] = -(ak / s) * my
+            g = ak * delta / s
+            s2 = s * s
+            kv[p, 0, 0] = g * (mu_l + dm * ex * ex - mx * ux / s2)
+            kv[p, 0, 1] = g * (dm * ex * ey - mx * uy / s2)
+            kv[p, 1, 0] = g * (dm * ey * ex - my * ux / s2)
+            kv[p, 1, 1] = g * (mu_l + dm * ey * ey - my * uy / s2)

@@ -187,15 +187,14 @@ class SeabedContact:
     def __init__(self, seabed, mesh, free_z: np.ndarray, area: np.ndarray,
                  stiffness: float | None = None):
         """``free_z`` (n_nodes,) bool: nodes whose z is free; ``area`` (n_nodes,) m²."""
-        self.zb = seabed.z
-        self.k = seabed.stiffness if stiffness is None else stiffness
-        self.c = seabed.damping if stiffness is None else 0.0
-        self.mu_a = seabed.friction_axial if stiffness is None else 0.0
-        self.mu_l = seabed.friction_lateral if stiffness is None else 0.0
-        self.vs = seabed.friction_velocity
+        self.zb = float(seabed.z)
+        self.k = float(seabed.stiffness if stiffness is None else stiffness)
+        self.c = float(seabed.damping) if stiffness is None else 0.0
+        self.mu_a = float(seabed.friction_axial) if stiffness is None else 0.0
+        self.mu_l = float(seabed.friction_lateral) if stiffness is None else 0.0
+        self.vs = float(seabed.friction_velocity)
         self.nodes = np.flatnonzero(free_z & (area > 0))  # (p,)
         self.area = area[self.nodes]
-        self.friction = self.mu_a > 0 or self.mu_l > 0
         # neighbours for the line direction: the other ends of the node's elements
         conn = mesh.conn
         nbr = np.full((mesh.n_nodes, 2), -1, np.int64)
@@ -235,76 +234,41 @@ class SeabedContact:
         -∂f/∂q and -∂f/∂v added (copies)."""
         kq, kv = self.derivatives(X.reshape(-1, 3), V.reshape(-1, 3))
         kdata, vdata = kdata.copy(), vdata.copy()
-        np.add.at(kdata, self.slots, kq.ravel())
-        np.add.at(vdata, self.slots, kv.ravel())
+        kdata[self.slots] += kq.ravel()  # the nodes' own blocks: no slot twice
+        vdata[self.slots] += kv.ravel()
         return kdata, vdata
 
-    def _direction(self, X):
-        d = X[self.nb_b, :2] - X[self.nb_a, :2]
-        n = np.hypot(d[:, 0], d[:, 1])
-        return d / np.where(n > 0, n, 1.0)[:, None]
-
     def forces(self, X: np.ndarray, V: np.ndarray | None = None):
-        """Force of the seabed on the nodes, (n_nodes, 3) N, and the contact data for the
-        derivatives: (in contact mask (p,), N (p,), friction factor pieces)."""
-        z = X[self.nodes, 2]
-        delta = self.zb - z
-        on = delta > 0.0
+        """Force of the seabed on the nodes, (n_nodes, 3) N (one compiled pass,
+        ``grounded.contact_forces``)."""
         out = np.zeros_like(X)
-        n_force = np.where(on, self.area * self.k * delta, 0.0)  # (p,) N
-        fz = n_force.copy()
-        if V is not None and self.c:
-            fz -= np.where(on, self.area * self.c * V[self.nodes, 2], 0.0)
-        out[self.nodes, 2] = fz
-        if V is not None and self.friction and on.any():
-            u = V[self.nodes, :2]
-            e = self._direction(X)
-            ua = np.einsum("pi,pi->p", u, e)
-            mu_u = self.mu_l * u + (self.mu_a - self.mu_l) * ua[:, None] * e  # M u
-            s = np.sqrt(np.einsum("pi,pi->p", u, u) + self.vs * self.vs)
-            out[self.nodes, :2] = -(n_force / s)[:, None] * mu_u
+        g.contact_forces(X, X if V is None else V, self.nodes, self.nb_a, self.nb_b, self.area,
+                         self.zb, self.k, self.c, self.mu_a, self.mu_l, self.vs, V is not None,
+                         out)
         return out
 
     def derivatives(self, X: np.ndarray, V: np.ndarray | None = None):
-        """-∂F/∂q and -∂F/∂v as (p, 3, 3) blocks at the contact nodes (the residual holds -F).
-        The line direction ê is held fixed (its derivative is left out of the iteration
-        matrix, which only has to be good)."""
+        """-∂F/∂q and -∂F/∂v as (p, 3, 3) blocks at the contact nodes (the residual holds -F;
+        one compiled pass, ``grounded.contact_derivatives``). The line direction ê is held
+        fixed (its derivative is left out of the iteration matrix, which only has to be good)."""
         p = self.nodes.size
         kq = np.zeros((p, 3, 3))
         kv = np.zeros((p, 3, 3))
-        delta = self.zb - X[self.nodes, 2]
-        on = delta > 0.0
-        ak = np.where(on, self.area * self.k, 0.0)
-        kq[:, 2, 2] = ak  # F_z = a k (z_b - z): -∂F_z/∂z = a k
-        if V is not None and self.c:
-            kv[:, 2, 2] = np.where(on, self.area * self.c, 0.0)
-        if V is not None and self.friction and on.any():
-            u = V[self.nodes, :2]
-            e = self._direction(X)
-            ua = np.einsum("pi,pi->p", u, e)
-            mu_u = self.mu_l * u + (self.mu_a - self.mu_l) * ua[:, None] * e
-            s = np.sqrt(np.einsum("pi,pi->p", u, u) + self.vs * self.vs)
-            n_force = ak * delta
-            # F_h = -N M u / s, N = a k δ: -∂F_h/∂z = -a k M u / s
-            kq[:, :2, 2] = -(ak / s)[:, None] * mu_u
-            mm = (self.mu_l * np.eye(2)[None]
-                  + (self.mu_a - self.mu_l) * e[:, :, None] * e[:, None, :])  # (p, 2, 2)
-            kv[:, :2, :2] = (n_force / s)[:, None, None] * (
-                mm - mu_u[:, :, None] * u[:, None, :] / (s * s)[:, None, None])
+        g.contact_derivatives(X, X if V is None else V, self.nodes, self.nb_a, self.nb_b,
+                              self.area, self.zb, self.k, self.c, self.mu_a, self.mu_l, self.vs,
+                              V is not None, kq, kv)
         return kq, kv
 
     def energy(self, X: np.ndarray) -> float:
         """Elastic energy of the contact springs, Σ ½ a k δ², J."""
         delta = np.maximum(self.zb - X[self.nodes, 2], 0.0)
-        return float(0.5 * np.sum(self.area * self.k * delta * delta))
+        return 0.5 * self.k * float(self.area @ (delta * delta))
 
     def dissipation(self, X: np.ndarray, V: np.ndarray) -> float:
-        """Power taken out of the motion by the seabed's damping and friction, W (>= 0)."""
-        f = self.forces(X, V)
-        fel = np.zeros_like(X)
-        delta = self.zb - X[self.nodes, 2]
-        fel[self.nodes, 2] = np.where(delta > 0, self.area * self.k * delta, 0.0)
-        return float(-np.sum((f - fel) * V))
+        """Power taken out of the motion by the seabed's damping and friction, W (>= 0): minus
+        the power of the contact forces less that of the springs (a k δ on ż)."""
+        elastic = self.k * np.maximum(self.zb - X[self.nodes, 2], 0.0) * self.area
+        return float(elastic @ V[self.nodes, 2]) - float(np.vdot(self.forces(X, V), V))
 
     def block_slots(self, pattern) -> np.ndarray:
         """Positions in the CSR data of ``pattern`` of the 3×3 block of every contact node,

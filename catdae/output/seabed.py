@@ -37,16 +37,15 @@ def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Data
                       axis=1)
     pos = ds.position.transpose("time", "node", "axis").values[:, order]
     td = np.full((z.shape[0], nc, 3), np.nan)
+    rows = np.arange(z.shape[0])
     for c in range(nc):
         els = np.flatnonzero(mesh.cable_of_element == c)
         a, b = mesh.conn[els, 0], mesh.conn[els, 1]
-        for k in range(z.shape[0]):
-            if length[k, c] <= 0.0:
-                continue
-            leave = np.flatnonzero(on[k, a] != on[k, b])
-            if leave.size:
-                e = leave[0]
-                td[k, c] = pos[k, a[e]] if on[k, a[e]] else pos[k, b[e]]
+        leave = on[:, a] != on[:, b]  # (nt, elements of the cable): one end on, one off
+        first = leave.argmax(axis=1)  # the first such element of each time
+        node = np.where(on[rows, a[first]], a[first], b[first])  # its end in contact
+        has = leave.any(axis=1) & (length[:, c] > 0.0)
+        td[has, c] = pos[rows[has], node[has]]
     if "cable" not in ds.coords:
         ds = ds.assign_coords(cable=label("cable", mesh.cable_names, "cable name"))
     ds["seabed_length"] = var(("time", "cable"), length, "m",

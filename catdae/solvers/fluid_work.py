@@ -20,19 +20,23 @@ class FluidWork:
         self.W = 0.0  # J, at time self.t
         self.t: float | None = None
         self.P = 0.0  # W, power at self.t
+        n = prob.n_dof
+        self._X, self._V, self._A = np.zeros(n), np.zeros(n), np.zeros(n)  # full dofs
 
     def power(self, t: float, y: np.ndarray, yp: np.ndarray) -> float:
         prob = self.prob
-        V, A = prob.full_vectors(t, y[1::2], yp[1::2])
-        X = prob.X.copy()
-        X[prob.fidx] = y[0::2]
-        X[prob.model.fixed] = prob.model.support_positions(t)
+        fidx, fixed = prob.fidx, prob.model.fixed
+        xp, vp, ap = prob._supports(t)
+        X, V, A = self._X, self._V, self._A  # every dof is free or fixed: all overwritten
+        X[fidx], V[fidx], A[fidx] = y[0::2], y[1::2], yp[1::2]
+        X[fixed], V[fixed], A[fixed] = xp, vp, ap
         out = self.fluid.evaluate(t, X, V, A)[0]  # M_a A - f
         return -float(out @ V)
 
-    def at(self, t: float, y: np.ndarray, yp: np.ndarray) -> float:
-        """W at t >= self.t (trapezoid from the last step's end)."""
-        p = self.power(t, y, yp)
+    def at(self, t: float, y: np.ndarray, yp: np.ndarray, power: float | None = None) -> float:
+        """W at t >= self.t (trapezoid from the last step's end); ``power`` P at (t, y, yp)
+        if the caller has it (an output: the residual pass there left the fluid's forces)."""
+        p = self.power(t, y, yp) if power is None else power
         if self.t is None:
             return 0.0
         return self.W + 0.5 * (self.P + p) * (t - self.t)

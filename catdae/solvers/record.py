@@ -43,8 +43,8 @@ class OutputRecord:
         self.X[k], self.V[k], self.A[k] = X.reshape(-1, 3), V.reshape(-1, 3), A.reshape(-1, 3)
         self.T[k], self.R[k], self.E[k] = T, R, E
         self.envelope.update(t, tension=T)
-        if self.work is not None:
-            self.W[k] = self.work.at(t, y, yp)
+        if self.work is not None:  # observe's residual pass left the fluid's M_a A - f
+            self.W[k] = self.work.at(t, y, yp, power=-float(self.prob.model.fluid.out @ V))
 
     def upto(self, n_valid: int, attrs: dict) -> OutputRecord:
         """This record with its first ``n_valid`` outputs valid and ``attrs`` set."""

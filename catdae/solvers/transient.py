@@ -232,7 +232,10 @@ class _Run:
                 self.status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
                 return
             t_new = float(np.atleast_1d(res.t)[-1])
-            if t_new > t_int:
+            # after an output interpolated inside the last step, IDA's next one-step call
+            # returns that step's end again without stepping: nothing new for the work
+            advanced = t_new > t_int
+            if advanced:
                 self.n_steps += 1
                 self.outputs.envelope.update(t_new, np.atleast_2d(res.y)[-1])
             # IDA's max_num_steps counts per call; in one-step mode guard the step size
@@ -248,7 +251,7 @@ class _Run:
             at_stop = ((t_stop < t_end or end_jump)
                        and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0))
             self._record_passed(solver, t_int, y_last, yp_last, at_stop)
-            if work is not None:
+            if work is not None and (advanced or at_stop):
                 work.advance(t_int, y_last, yp_last)
             if at_stop:
                 t_int = t_stop

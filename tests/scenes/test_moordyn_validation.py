@@ -49,8 +49,9 @@ def test_jumper_static_end_forces():
                                            (600, "ZZP1_A1"), (600, "ZZP1_A2")])
 def test_chain_heave_against_orcaflex(depth, motion):
     """The chain under the 2 m and 5 m heave records (30 s after 10 s of lead-in; the fairlead
-    leaves the water and returns), 20 elements, rtol 1e-3, MoorDyn's axial damping: within
-    MoorDyn's dynamic tolerance 0.15 of OrcaFlex (MoorDyn itself: 0.09-0.12)."""
+    leaves the water and returns), 20 elements, rtol 1e-3, MoorDyn's axial damping, friction
+    smoothed below 0.1 m/s (tests/moordyn_scenes.py): within MoorDyn's dynamic tolerance 0.15
+    of OrcaFlex (0.102, 0.097, 0.117, 0.115; MoorDyn itself: 0.09-0.12)."""
     tree = _run(chain_toml(depth, motion=motion, elements=20, rtol=1e-3))
     static = np.linalg.norm(tree["static"].to_dataset().reaction.sel(node="fairlead").values)
     ds = tree["heave"].to_dataset()

@@ -73,8 +73,13 @@ def test_contact_derivatives_are_finite_differences():
     X = np.array([[0.0, 0.0, -1.0], [1.0, 0.2, -1.01], [2.0, 0.5, -1.003], [3.0, 0.4, -1.02]])
     V = rng.normal(scale=0.04, size=(4, 3))
     kq, kv = c.derivatives(X, V)
-    e_fixed = c._direction(X)
-    c._direction = lambda _X: e_fixed  # hold ê, as the iteration matrix does
+    # hold ê, as the iteration matrix does: the direction is taken from copies of the
+    # neighbours (rows appended to X) that the perturbations below do not move
+    n = X.shape[0]
+    ghosts = np.concatenate([c.nb_a, c.nb_b])
+    c.nb_a, c.nb_b = n + np.arange(c.nodes.size), n + c.nodes.size + np.arange(c.nodes.size)
+    X = np.vstack([X, X[ghosts]])
+    V = np.vstack([V, V[ghosts]])
     for p, node in enumerate(c.nodes):
         for a in range(3):
             for which, blk in (("q", kq), ("v", kv)):

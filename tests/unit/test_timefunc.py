@@ -178,6 +178,25 @@ def test_evaluate_is_vectorised_and_scalar_in_gives_floats():
         assert func(0.3) == func.evaluate(0.3)[0]
 
 
+def test_table_at_one_time_is_scipys_spline():
+    """One time at a time (the residual's path: bisection and the cubics in floats) gives
+    scipy's not-a-knot spline and its derivatives, at the knots, between them and at the ends
+    of a 3000-point record; outside it the held end values at rest."""
+    rng = np.random.default_rng(7)
+    t = np.cumsum(rng.uniform(0.05, 0.15, 3000))
+    v = np.sin(t) + 0.1 * rng.standard_normal(t.size)
+    table = Table(tuple(t), tuple(v))
+    sp = CubicSpline(t, v)
+    probes = np.concatenate([t[:-1], rng.uniform(t[0], t[-1], 500), [t[0], t[-2]]])
+    scale = np.abs(v).max()
+    for x in probes:
+        got = table.evaluate(float(x))
+        for k in range(3):
+            assert got[k] == pytest.approx(float(sp(x, k)), rel=1e-12, abs=1e-12 * scale)
+    assert table.evaluate(float(t[-1])) == (pytest.approx(v[-1], abs=1e-12), 0.0, 0.0)
+    assert table.evaluate(float(t[0] - 1.0)) == (pytest.approx(v[0], abs=1e-12), 0.0, 0.0)
+
+
 def test_constant_and_absence_convention():
     assert Constant(4.0).evaluate(np.array([0.0, 7.0]))[0].tolist() == [4.0, 4.0]
     assert evaluate_or(None, 3.0, absent=ONE) == (1.0, 0.0, 0.0)
