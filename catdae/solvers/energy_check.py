@@ -24,12 +24,10 @@ def support_work(model, times: np.ndarray, R: np.ndarray) -> np.ndarray:
     W = np.zeros(times.size)
     if not model.motions or times.size < 2:
         return W
-    fixed = model.fixed
-    p = np.empty(times.size)
-    for k, t in enumerate(times):
-        v = model.support_values(float(t))[1]
-        r = R[k].reshape(-1)[fixed]
-        p[k] = float(np.nansum(r * v))
+    flat = R.reshape(times.size, -1)
+    p = np.zeros(times.size)
+    for dof, tf in model.motions:  # R · v_s, each moving axis with its own time function
+        p += np.nan_to_num(flat[:, dof]) * np.asarray(tf.evaluate(times)[1], float)
     W[1:] = np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(times))
     return W
 

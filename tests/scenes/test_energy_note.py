@@ -128,10 +128,10 @@ def test_support_work_enters_the_balance():
     E = np.zeros((n, 3))
     E[:, 0] = 2.0 * t
     rec = SimpleNamespace(times=t, E=E, W=np.zeros(n), work=None, R=R)
-    moving = SimpleNamespace(
-        motions=[(0, None)], fixed=np.array([0]),
-        support_values=lambda _t: (np.zeros(1), np.ones(1), np.zeros(1)),
-        loading=SimpleNamespace(node_timed=[], internal_timed=[]))
+    unit_speed = SimpleNamespace(evaluate=lambda tt: (np.asarray(tt), np.ones_like(tt),
+                                                      np.zeros_like(tt)))
+    moving = SimpleNamespace(motions=[(0, unit_speed)],
+                             loading=SimpleNamespace(node_timed=[], internal_timed=[]))
     prob = SimpleNamespace(step=SimpleNamespace(rtol=1e-4), velocity_jumps=[])
     assert energy_gain(moving, prob, rec, n) is None
     moving.motions = []
