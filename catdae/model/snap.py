@@ -40,11 +40,34 @@ def velocity_jumps(model, V: np.ndarray, t0: float, t1: float) -> list[tuple[flo
     return out
 
 
-def unbalance(model, state, X: np.ndarray, t0: float) -> tuple[float, int]:
+def jump_floor(model, state) -> float:
+    """m/s: the smallest support velocity jump whose axial (water-hammer) wave counts, from the
+    element ``state`` a step starts in: m c Δv = ``SNAP_SHARE`` of the largest tension there
+    (c = sqrt(EA/m); 0 when nothing is in tension: every jump counts). A record's spline that
+    starts at a round-off velocity, or a velocity kink of a few µm/s, does not count."""
+    t_max = float(model.tensions(state).max(initial=0.0))
+    impedance = float(np.sqrt(model.mesh.EA * model.mesh.m).max(initial=0.0))  # m c, N s/m
+    return SNAP_SHARE * t_max / impedance if impedance > 0.0 else np.inf
+
+
+def unbalance(model, state, X: np.ndarray, t0: float,
+              V: np.ndarray | None = None) -> tuple[float, int]:
     """(the largest out-of-balance force on a free node at t0, N; that node's index): what a
     step that starts out of equilibrium (a load or mass added or removed, a mass let go)
-    releases at once."""
-    r = (model.internal_force(state, X) - model.nodal_load(t0)).reshape(-1, 3)
+    releases at once. The forces are those of the transient's residual at t0 with no
+    acceleration: the elements, the loads, the water and air (buoyancy, drag on the velocities
+    ``V``, the waves at t0) and the seabed's contact springs, so that a line resting on the
+    seabed or held up by its buoyancy in the static state is in balance here too."""
+    r = model.internal_force(state, X) - model.nodal_load(t0)
+    v = np.zeros(r.size) if V is None else np.asarray(V, float).reshape(-1)
+    if model.fluid is not None:  # M_a A - f_fluid at A = 0: -f_fluid
+        r = r + model.fluid.evaluate(t0, X, v, np.zeros(r.size))[0]
+    if model.case.seabed is not None and model.case.seabed.stiffness is not None:
+        from catdae.model.seabed import SeabedContact  # only scenes with a seabed
+
+        contact = SeabedContact.of_model(model)
+        r = r - contact.forces(np.reshape(X, (-1, 3)), v.reshape(-1, 3)).ravel()
+    r = r.reshape(-1, 3)
     r[model.fixed_mask] = 0.0  # the supports take theirs as reactions
     norms = np.linalg.norm(r, axis=1)
     k = int(np.argmax(norms))
@@ -68,7 +91,7 @@ def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
     where = (f"{int(sag.sum())} of {lam2.size} elements take a chord change by sag (λ² up to "
              + ("inf, slack" if not np.isfinite(worst) else f"{worst:.3g}") + ", > 1)")
     t_max = float(model.tensions(state).max(initial=0.0))
-    force, node = unbalance(model, state, X, t0)
+    force, node = unbalance(model, state, X, t0, V)
     if force >= SNAP_SHARE * t_max:
         changed = [*step.add, *step.remove]
         what = (f"{', '.join(repr(c) for c in changed)} added or removed" if changed else
@@ -76,10 +99,9 @@ def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
         return (f"the step starts out of balance by {force:.3g} N at node "
                 f"{model.mesh.node_names[node]} ({what}; the largest tension is {t_max:.3g} N) "
                 f"while {where}")
-    mesh = model.mesh
-    impedance = float(np.sqrt(mesh.EA * mesh.m).max(initial=0.0))  # m c, N s/m
+    floor = jump_floor(model, state)
     jumps = [j for j in velocity_jumps(model, V, t0, t0 + float(step.duration))
-             if impedance * j[1] >= SNAP_SHARE * t_max]
+             if j[1] >= floor]
     if jumps:
         t, dv = jumps[0]
         return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s while "

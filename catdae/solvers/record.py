@@ -92,7 +92,8 @@ def _mass_note(model: Model, prob) -> str:
                 "is expected (smooth motion converges faster with it; docs/accuracy.md)")
     if not model.mass_model.catenary:
         return ""
-    jumps = [j for j in prob.velocity_jumps if j[2] > 1.0]
+    floor = prob.jump_floor  # jumps whose wave counts (catdae.model.snap.jump_floor)
+    jumps = [j for j in prob.velocity_jumps if j[2] > 1.0 and j[1] >= floor]
     changed = [*prob.step.add, *prob.step.remove]
     lam2 = getattr(prob, "lambda2_start", 0.0)
     if not jumps and changed and lam2 > 1.0:

@@ -101,6 +101,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self.n_jac = 0
         # (t, largest |Δv_s| m/s, largest element λ²) of each support velocity jump
         self.velocity_jumps: list[tuple[float, float, float]] = []
+        self.jump_floor = 0.0  # m/s: smaller support velocity jumps send no wave that counts
         self.n_rejected = 0
         self._fast_setup()
         # the seabed's penalty contact (docs/theory.md §17); None for a scene without one

@@ -23,7 +23,7 @@ from sksundae.ida import IDA
 
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
-from catdae.model.snap import velocity_jumps
+from catdae.model.snap import jump_floor, velocity_jumps
 from catdae.progress import reporter
 from catdae.solvers.order import (
     OrderChoice,
@@ -101,6 +101,7 @@ class _Run:
         self.times = output_times(self.t0, float(step.duration), self.dt_out)
         self.y0, self.yp0 = prob.initial(self.t0, state.X, state.V)
         self.V_start = state.V
+        self.X_start, self.h_start = state.X, state.h
         self._ida_options()
         self.outputs = OutputRecord(prob, self.times)
         self.n_steps = self.n_restarts = 0
@@ -113,6 +114,10 @@ class _Run:
         step, prob, t0, y0 = self.step, self.prob, self.t0, self.y0
         self.linsolver = choose_solver(prob, step.linear_solver)
         self.omega = reference_frequency(prob, t0, y0)
+        # the note's floor: jumps whose wave counts (m c Δv >= 5 % of the largest tension);
+        # the error test follows any jump's wave (a small one on a taut line may be asked for)
+        prob.jump_floor = jump_floor(self.model, self.model.element_state(self.X_start,
+                                                                          self.h_start))
         jumps = velocity_jumps(self.model, self.V_start, t0, self.t_end)
         self.resolve, self.resolve_choice = resolve_mode(
             step.resolve, self.model.mass_model.carries_axial_waves, bool(jumps))

@@ -1,0 +1,55 @@
+"""What ``mass_model = "auto"`` and ``resolve = "auto"`` see at the start of a transient on a
+mooring chain resting on contact springs in water (catdae.model.snap, docs/theory.md §18.5):
+
+- the static state the step starts from is in balance with the forces the transient has at
+  rest (buoyancy, the seabed's springs), so no "release" is seen and the blended mass is kept;
+  the same chain with a clump weight taken off at the start is out of balance by that weight
+  (the closed form: its force), and takes the lumped mass;
+- the fairlead record's spline starts at a velocity of order 1e-4 m/s, a jump whose axial wave
+  (m c Δv) is far below 5 % of the tension: the note says nothing of it.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+
+import catdae
+
+from repo_paths import CASES  # noqa: E402
+
+CLUMP = 2.0e5  # N
+
+
+def _chain(tmp_path, duration: float = 0.5, clump: bool = False) -> str:
+    text = (CASES / "mooring_chain_200m.toml").read_text()
+    text = text.replace("duration = 60.0", f"duration = {duration}")
+    text = text.replace("output_interval = 0.5", "output_interval = 0.1")
+    if clump:  # a clump weight on the suspended part, there in the static step, gone after
+        text = text.replace('[[support_motions]]', f'''[[loads]]
+name = "clump"
+node = "chain.14"
+force = [0.0, 0.0, {-CLUMP}]
+
+[[support_motions]]''', 1)
+        text = text.replace('name = "heave_surge"', 'name = "heave_surge"\nremove = ["clump"]')
+    shutil.copy(CASES / "chain_fairlead_record.csv", tmp_path)
+    path = tmp_path / "chain.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def test_a_chain_resting_on_the_seabed_starts_in_balance(tmp_path):
+    ds = catdae.run(_chain(tmp_path))["heave_surge"].to_dataset()
+    assert ds.attrs["mass_model"] == "blended", ds.attrs["mass_model_choice"]
+    assert "out of balance" not in ds.attrs["mass_model_choice"]
+    assert "jumps" not in ds.attrs["note"]
+
+
+def test_a_clump_weight_taken_off_the_chain_is_a_release(tmp_path):
+    ds = catdae.run(_chain(tmp_path, clump=True))["heave_surge"].to_dataset()
+    assert ds.attrs["mass_model"] == "lumped"
+    choice = ds.attrs["mass_model_choice"]
+    assert "'clump' added or removed" in choice
+    force = float(re.search(r"out of balance by ([0-9.e+]+) N at node chain\.14", choice)[1])
+    assert abs(force / CLUMP - 1.0) < 5e-3  # the weight taken off, to the printed digits
