@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae.model.assembly import Model
+from catdae.solvers.energy_check import gain_note
 from catdae.solvers.envelope import TensionEnvelope
 from catdae.solvers.fluid_work import FluidWork
 
@@ -76,8 +77,15 @@ def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
     return strain, gravity
 
 
-def note(model: Model, prob) -> str:
-    """Advice on the result's accuracy that the run itself found ("" when none)."""
+def note(model: Model, prob, rec: OutputRecord | None = None, n_valid: int = 0) -> str:
+    """Advice on the result's accuracy that the run itself found ("" when none): on the mass
+    model, and (given the record and its ``n_valid`` outputs) an energy balance that does not
+    close (catdae/solvers/energy_check.py)."""
+    advice = [_mass_note(model, prob), gain_note(model, prob, rec, n_valid)]
+    return "; ".join(a for a in advice if a)
+
+
+def _mass_note(model: Model, prob) -> str:
     if model.mass_model.snap:
         return ("mass_model \"auto\" chose \"lumped\", a mass that carries axial (snap) waves, "
                 f"because {model.mass_model.snap}; give mass_model = \"blended\" where no snap "

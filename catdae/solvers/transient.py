@@ -174,7 +174,8 @@ class _Run:
             "paper" if model.mass_model.catenary else "constant mass",
             "damping": prob.damping.kind,
             "rayleigh_alpha": prob.alpha, "rayleigh_beta": prob.beta,
-            "n_outputs": n_valid, "n_restarts": self.n_restarts, "note": note(model, prob),
+            "n_outputs": n_valid, "n_restarts": self.n_restarts,
+            "note": note(model, prob, self.outputs, n_valid),
             "axial_damping": "none" if prob.axial is None else prob.axial.describe(),
         }
 

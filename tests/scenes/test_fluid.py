@@ -356,3 +356,29 @@ def test_energy_balance_with_the_work_of_the_water(current):
     E, W = ds.energy_total.values, ds.energy_fluid_work.values
     assert W[-1] < -100.0  # the water took a good part of the energy of the release
     np.testing.assert_allclose(E - E[0], W, rtol=0, atol=1e-4 * abs(W[-1]))
+
+
+@pytest.mark.parametrize("mass_model", ["blended", "lumped"])
+def test_drag_through_the_surface_only_takes_energy(mass_model):
+    """In still water and still air the drag's power on the nodes, -(out(V) - out(0)) · V, is
+    never positive, for any node velocities, on a line whose elements cross the surface (the
+    wet and dry parts' mapped Gauss rules, docs/theory.md §13.2, weigh each point by its share
+    of the chord): the drag cannot feed a motion (docs/theory.md §13.6)."""
+    air = "[air]\ndensity = 1.3\n"
+    model, prob, sol = _problem(_water() + air, (0.0, 0.0, -60.0), (100.0, 20.0, 20.0),
+                                mass_model)
+    fluid = model.fluid
+    X = sol.X.reshape(-1)
+    z = X[2::3]
+    conn = fluid.conn
+    assert np.any((z[conn[:, 0]] < 0.0) != (z[conn[:, 1]] < 0.0))  # an element crosses
+    zero = np.zeros_like(X)
+    at_rest = fluid.evaluate(0.0, X, zero, zero)[0].copy()
+    rng = np.random.default_rng(5)
+    powers = []
+    for _ in range(200):
+        V = rng.standard_normal(X.size) * rng.choice([0.01, 1.0, 10.0])
+        out = fluid.evaluate(0.0, X, V, zero)[0]
+        powers.append(-float((out - at_rest) @ V) / max(float(V @ V), 1e-300))
+    assert max(powers) <= 0.0
+    assert min(powers) < 0.0

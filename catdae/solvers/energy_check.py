@@ -1,0 +1,79 @@
+"""Does a transient step's energy balance close? (docs/theory.md §13.6)
+
+Without damping the semi-discrete equations conserve the total energy plus the work done on
+the line from outside (the fluid's, §13.5, and the moving supports'); damping, drag, seabed
+friction and the BDF's own dissipation only take energy out. A run that *gains* energy beyond
+that balance is not following its equations (in the cases seen: an axial ringing that the error
+test resolves and nothing damps, fed by the integration error) and its tensions are not to be
+trusted. ``energy_gain`` measures the gain at the output times; ``note`` of
+catdae/solvers/record.py reports it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+GAIN_LIMIT = 1e-2  # of the energy moved, or 10 rtol if that is larger
+JUMP_LIMIT = 1e-3  # m/s: a larger support velocity jump does impulsive work the outputs miss
+
+
+def support_work(model, times: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """Work of the moving supports on the line, J, at the output times: the trapezoidal rule on
+    R · v_s (R the supports' forces on the line at the outputs, v_s their prescribed velocity;
+    zero where no support moves)."""
+    W = np.zeros(times.size)
+    if not model.motions or times.size < 2:
+        return W
+    flat = R.reshape(times.size, -1)
+    p = np.zeros(times.size)
+    for dof, tf in model.motions:  # R · v_s, each moving axis with its own time function
+        p += np.nan_to_num(flat[:, dof]) * np.asarray(tf.evaluate(times)[1], float)
+    W[1:] = np.cumsum(0.5 * (p[1:] + p[:-1]) * np.diff(times))
+    return W
+
+
+def energy_gain(model, prob, rec, n_valid: int):
+    """(gain J, energy moved J, first time s the gain passed the limit, its limit J), or None
+    when the balance cannot be closed at the outputs (loads that vary in time, support velocity
+    jumps, fewer than two outputs) or no energy was gained beyond the limit."""
+    if n_valid < 2 or rec is None:
+        return None
+    ld = model.loading
+    if ld.node_timed or ld.internal_timed:
+        return None  # their work is not recorded
+    if any(j[1] > JUMP_LIMIT for j in getattr(prob, "velocity_jumps", [])):
+        return None
+    t = rec.times[:n_valid]
+    E = rec.E[:n_valid].sum(axis=1)
+    if not np.all(np.isfinite(E)):
+        return None
+    dE = E - E[0]
+    W = rec.W[:n_valid] if rec.work is not None else np.zeros(n_valid)
+    W = np.nan_to_num(W)
+    Ws = support_work(model, t, rec.R[:n_valid])
+    gap = dE - W - Ws
+    # the energy moved in or out, and the largest kinetic and strain energies: the scale of
+    # the state's own energy, whose integration error is of order rtol of it
+    moved = float(np.abs(dE).max() + np.abs(W).max() + np.abs(Ws).max()
+                  + np.abs(rec.E[:n_valid, 0]).max() + np.abs(rec.E[:n_valid, 1]).max())
+    limit = max(GAIN_LIMIT, 10.0 * float(prob.step.rtol)) * moved
+    gain = float(gap.max())
+    if not moved > 0.0 or gain <= limit:
+        return None
+    first = float(t[np.argmax(gap > limit)])
+    return gain, moved, first, limit
+
+
+def gain_note(model, prob, rec, n_valid: int) -> str:
+    """The note on an energy gain ("" when the balance closes or cannot be closed)."""
+    found = energy_gain(model, prob, rec, n_valid)
+    if found is None:
+        return ""
+    gain, moved, first, _ = found
+    return (f"the energy balance does not close: the run gained {gain:.3g} J that no force "
+            f"supplied ({gain / moved:.2g} of {moved:.3g} J, the energy that the supports "
+            "and the fluid moved plus the line's largest kinetic and strain energies; past "
+            f"{GAIN_LIMIT:g} of it from t = {first:.6g} s): the run is not following its "
+            "equations there (in the cases seen, an element's undamped axial ringing grows) "
+            "and its tensions are not reliable; add axial_damping (e.g. { ratio = 0.5 }) or "
+            "tighten rtol (docs/theory.md §13.6)")
