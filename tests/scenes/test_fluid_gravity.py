@@ -61,7 +61,7 @@ def water_scene(Q, rigid: bool = False) -> str:
         "exponent = 0.12 }\n"
         f"[seabed]\n{bed}")
     steps = step("static", "s") + ("" if rigid else step("modal", "m", modes=4) + step(
-        "transient", "t", duration=1.0, output_interval=0.25, rtol=1e-8, atol=1e-10))
+        "transient", "t", duration=1.0, output_interval=0.25, rtol=1e-10, atol=1e-12))
     return scene(nodes={"A": Q @ np.array([0.0, 0.0, -50.0]),
                         "B": Q @ np.array([80.0, 20.0, 3.0])},
                  cables='[[cables]]\nname = "c"\nends = ["A", "B"]\nmaterial = "chain"\n'
