@@ -288,10 +288,10 @@ def test_failure_keeps_partial_results(tmp_path, monkeypatch):
 
     orig = transient.TransientProblem.evaluate  # where a transient solves its elements
 
-    def failing(self, t, y, yp, res):
+    def failing(self, t, y, yp, res, **kw):
         if t > 0.05:
             return False
-        return orig(self, t, y, yp, res)
+        return orig(self, t, y, yp, res, **kw)
 
     monkeypatch.setattr(transient.TransientProblem, "evaluate", failing)
     out = tmp_path / "run.nc"
