@@ -286,11 +286,13 @@ def _step_lines(name: str, ds) -> list[str]:
         free = ds.reaction.isnull().all(("time", "axis"))
         d = ds.displacement.isel(node=np.flatnonzero(free.values)) if bool(free.any()) \
             else ds.displacement
+        d = d - d.isel(time=0)  # during the step (displacement is from the case's geometry)
         mag = np.sqrt((d**2).sum("axis"))
         node = str(mag.max("time").idxmax("node").values)
-        top = (f"; max tension {float(ds.tension.max()):.6g} N" if ds.sizes.get("element")
-               else "")  # a scene of connectors alone has no cable element
-        lines.append(f"    largest motion of a free node at {node}: "
+        tmax = ds.tension_max if "tension_max" in ds else ds.get("tension")  # envelope
+        top = (f"; max tension {float(tmax.max()):.6g} N" if ds.sizes.get("element")
+               and tmax is not None else "")  # a scene of connectors alone has no element
+        lines.append(f"    largest motion of a free node during the step at {node}: "
                      f"{float(mag.sel(node=node).max()):.4g} m{top}")
         lines.extend(_jump_lines(ds))
         if a.get("note"):

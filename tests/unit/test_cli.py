@@ -212,11 +212,17 @@ def test_the_summary_names_the_free_node_that_moves_most(tmp_path, capsys):
                  "--no-progress"]) == 0
     printed = capsys.readouterr().out
     ds = catdae.read_results(out)["excitation"].to_dataset()
-    mag = np.sqrt((ds.displacement**2).sum("axis")).max("time")
+    moved = ds.position - ds.position.isel(time=0)  # the motion during the step
+    mag = np.sqrt((moved**2).sum("axis")).max("time")
     free = [n for n in ds.node.values if n not in ("A", "B")]
     expected = str(mag.sel(node=free).idxmax("node").values)
     assert float(mag.sel(node="A")) > float(mag.sel(node=expected))  # A moves most of all
-    assert f"largest motion of a free node at {expected}: " in printed
+    line = f"largest motion of a free node during the step at {expected}: "
+    assert line in printed
+    shown = float(printed.split(line)[1].split(" m")[0])
+    assert shown == pytest.approx(float(mag.sel(node=expected)), rel=1e-3)  # 4 digits printed
+    peak = float(printed.split("max tension ")[1].split(" N")[0])
+    assert peak == pytest.approx(float(ds.tension_max.max()), rel=1e-5)  # the envelope's
 
 
 def test_a_run_under_a_profiler_ends_the_ordinary_way_and_keeps_its_profile(tmp_path):
