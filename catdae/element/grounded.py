@@ -281,6 +281,19 @@ def position_batch(h, w, ea, l0, mode, s, out):
 # --------------------------------------------------------------------------------------------
 # The seabed's penalty contact at the nodes (catdae.model.seabed.SeabedContact; §17.5)
 @njit(cache=True)
+def horizontal_direction(X, a, b):
+    """(ê_x, ê_y): the horizontal unit direction from node a to node b (zeros when they are
+    one above the other), the line's direction at a contact node from its neighbours."""
+    ex = X[b, 0] - X[a, 0]
+    ey = X[b, 1] - X[a, 1]
+    en = np.sqrt(ex * ex + ey * ey)
+    if en > 0.0:
+        ex /= en
+        ey /= en
+    return ex, ey
+
+
+@njit(cache=True)
 def contact_forces(X, V, nodes, nb_a, nb_b, area, zb, k, c, mu_a, mu_l, vs, use_v, out):
     """Force of the seabed on each contact node below z_b, into ``out`` (n_nodes, 3), which
     holds zeros there: N = a k δ up, -a c ż with the velocities, and the smoothed Coulomb
@@ -299,12 +312,7 @@ def contact_forces(X, V, nodes, nb_a, nb_b, area, zb, k, c, mu_a, mu_l, vs, use_
         out[i, 2] = fz
         if friction:
             ux, uy = V[i, 0], V[i, 1]
-            ex = X[nb_b[p], 0] - X[nb_a[p], 0]
-            ey = X[nb_b[p], 1] - X[nb_a[p], 1]
-            en = np.sqrt(ex * ex + ey * ey)
-            if en > 0.0:
-                ex /= en
-                ey /= en
+            ex, ey = horizontal_direction(X, nb_a[p], nb_b[p])
             ua = ux * ex + uy * ey
             g = n / np.sqrt(ux * ux + uy * uy + vs * vs)
             out[i, 0] = -g * (mu_l * ux + (mu_a - mu_l) * ua * ex)
@@ -328,12 +336,7 @@ def contact_derivatives(X, V, nodes, nb_a, nb_b, area, zb, k, c, mu_a, mu_l, vs,
             kv[p, 2, 2] = area[p] * c
         if friction:
             ux, uy = V[i, 0], V[i, 1]
-            ex = X[nb_b[p], 0] - X[nb_a[p], 0]
-            ey = X[nb_b[p], 1] - X[nb_a[p], 1]
-            en = np.sqrt(ex * ex + ey * ey)
-            if en > 0.0:
-                ex /= en
-                ey /= en
+            ex, ey = horizontal_direction(X, nb_a[p], nb_b[p])
             dm = mu_a - mu_l
             ua = ux * ex + uy * ey
             mx = mu_l * ux + dm * ua * ex

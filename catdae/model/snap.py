@@ -62,11 +62,12 @@ def unbalance(model, state, X: np.ndarray, t0: float,
     v = np.zeros(r.size) if V is None else np.asarray(V, float).reshape(-1)
     if model.fluid is not None:  # M_a A - f_fluid at A = 0: -f_fluid
         r = r + model.fluid.evaluate(t0, X, v, np.zeros(r.size))[0]
-    if model.case.seabed is not None and model.case.seabed.stiffness is not None:
+    if model.case.seabed is not None:
         from catdae.model.seabed import SeabedContact  # only scenes with a seabed
 
-        contact = SeabedContact.of_model(model)
-        r = r - contact.forces(np.reshape(X, (-1, 3)), v.reshape(-1, 3)).ravel()
+        contact = SeabedContact.of_step(model)  # the transient's springs (None when rigid)
+        if contact is not None:
+            r = r - contact.forces(np.reshape(X, (-1, 3)), v.reshape(-1, 3)).ravel()
     r = r.reshape(-1, 3)
     r[model.fixed_mask] = 0.0  # the supports take theirs as reactions
     norms = np.linalg.norm(r, axis=1)

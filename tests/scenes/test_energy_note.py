@@ -19,50 +19,23 @@ import catdae
 from catdae.case import load_case
 from catdae.solvers.energy_check import GAIN_LIMIT, energy_gain
 
+from scene_toml import block, cable, load, scene, section, step
+
 
 def _scene(damping: str = "") -> str:
-    return f"""
-gravity = 9.807
-[materials.m]
-EA = 500.0e6
-mass = 165.0
-diameter = 0.396
-drag_normal = 0.0
-added_mass_normal = 1.0
-[water]
-density = 1000.0
-surface = 0.0
-depth = 100.0
-[nodes]
-bottom = [-20.0, 0.0, -15.0]
-top = [0.0, 0.0, 5.0]
-[supports]
-bottom = "pinned"
-top = "pinned"
-[[cables]]
-name = "c"
-ends = ["bottom", "top"]
-material = "m"
-length = 30.0
-elements = 6
-[[loads]]
-name = "push"
-node = "c.3"
-force = [-20000.0, 0.0, 20000.0]
-[[steps]]
-kind = "static"
-name = "static"
-[[steps]]
-kind = "transient"
-name = "free"
-remove = ["push"]
-duration = 15.0
-output_interval = 0.01
-rtol = 1e-4
-atol = 1e-4
-mass_model = "blended"
-{damping}
-"""
+    return scene(
+        head={"gravity": 9.807},
+        materials={"m": {"EA": 500.0e6, "mass": 165.0, "diameter": 0.396, "drag_normal": 0.0,
+                         "added_mass_normal": 1.0}},
+        nodes={"bottom": [-20.0, 0.0, -15.0], "top": [0.0, 0.0, 5.0]},
+        supports=("bottom", "top"),
+        cables=cable("c", ("bottom", "top"), length=30.0, elements=6),
+        extra=(section("water", density=1000.0, surface=0.0, depth=100.0)
+               + load("push", [-20000.0, 0.0, 20000.0], node="c.3")),
+        steps=(step("static", "static")
+               + step("transient", "free", remove=["push"], duration=15.0,
+                      output_interval=0.01, rtol=1e-4, atol=1e-4, mass_model="blended")
+               + block(damping)))
 
 
 def _balance(ds):
