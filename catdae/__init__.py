@@ -7,6 +7,7 @@ import importlib.abc
 import importlib.util
 import sys
 
+from catdae._numpy_extras import defer as _defer_numpy_extras
 from catdae._version import __version__
 from catdae.element.cache import purge_stale as _purge_stale
 from catdae.errors import (
@@ -20,6 +21,8 @@ from catdae.errors import (
 
 # numba's cache follows each kernel's own file only: drop cached kernels whose callees changed
 _purge_stale()
+# numpy.f2py and numpy.testing load at their first use, not with scipy (catdae/_numpy_extras.py)
+_defer_numpy_extras()
 
 
 

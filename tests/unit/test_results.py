@@ -293,3 +293,48 @@ def test_a_run_does_not_import_dask_and_dask_arrays_still_work(tmp_path):
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.startswith("ok")
+
+
+_NUMPY_EXTRAS_PROBE = r"""
+import sys
+import catdae
+tree = catdae.run(sys.argv[1], progress=False)  # imports scipy.sparse, .linalg, .optimize
+ran = [m for m in ("numpy.f2py.f2py2e", "numpy.f2py.crackfortran", "numpy.testing._private.utils")
+       if m in sys.modules]
+assert not ran, f"a run executed {ran}"
+import numpy as np
+np.testing.assert_allclose(np.ones(3), np.ones(3))  # the first use loads the real module
+from numpy.testing import assert_array_equal
+assert_array_equal(np.arange(2), [0, 1])
+assert "numpy.testing._private.utils" in sys.modules
+import numpy.f2py
+assert numpy.f2py.get_include().endswith("src"), numpy.f2py.get_include()
+assert type(sys.modules["numpy.f2py"]) is type(sys)  # the ordinary module once loaded
+print("ok")
+"""
+
+
+def test_a_run_leaves_numpy_f2py_and_testing_to_their_first_use(tmp_path):
+    """scipy's array-API layer imports numpy.f2py and numpy.testing with every scipy.sparse,
+    .linalg or .optimize import (about 0.06 s of CPU); catdae enters both as lazy modules
+    (catdae/_numpy_extras.py). Checked in a fresh process: a whole transient run executes
+    neither, and both work in full at their first use afterwards. A process that imported
+    numpy.testing before catdae keeps its module as it was."""
+    import subprocess
+    import sys
+
+    case = tmp_path / "case.toml"
+    case.write_text(CASE)
+    proc = subprocess.run([sys.executable, "-c", _NUMPY_EXTRAS_PROBE, str(case)],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip().endswith("ok")
+    before = ("import sys, numpy.testing; real = sys.modules['numpy.testing']\n"
+              "import catdae, catdae._numpy_extras as x\n"
+              "assert 'numpy.testing' not in x.defer()\n"
+              "assert sys.modules['numpy.testing'] is real and type(real) is type(sys)\n"
+              "print('ok')")
+    proc = subprocess.run([sys.executable, "-c", before], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip().endswith("ok")
