@@ -10,6 +10,7 @@ import sys
 from catdae._numpy_extras import defer as _defer_numpy_extras
 from catdae._version import __version__
 from catdae.element.cache import purge_stale as _purge_stale
+from catdae.element.cache import write_bytecode as _write_bytecode
 from catdae.errors import (
     CaseError,
     CatdaeError,
@@ -21,6 +22,8 @@ from catdae.errors import (
 
 # numba's cache follows each kernel's own file only: drop cached kernels whose callees changed
 _purge_stale()
+if sys.flags.dont_write_bytecode:  # catdae's own bytecode all the same (catdae/element/cache.py)
+    _write_bytecode()
 # numpy.f2py and numpy.testing load at their first use, not with scipy (catdae/_numpy_extras.py)
 _defer_numpy_extras()
 

@@ -23,6 +23,14 @@ rest only serves compiling. So a cached kernel is loaded after those two; compil
 not in the cache, a call with new argument types) goes through numba's own path, which
 refreshes fully first. The machine code run is the same, so are the results (bit for bit:
 benchmarks/same_results.py).
+
+The bytecode of catdae's own modules (:func:`write_bytecode`): where the interpreter was told not
+to write bytecode (``PYTHONDONTWRITEBYTECODE``, ``python -B``), an editable or source install
+compiled all of catdae's modules from source in every process, about 0.1 s of CPU per ``catdae
+run`` (benchmarks/startup.md). A regular ``pip install`` writes that bytecode at install; for the
+others it is written at import, beside numba's kernel cache in the package's ``__pycache__``
+folders, and only for files whose bytecode is missing or older than the source (Python checks
+each file's stamp at import and ignores bytecode that no longer matches its source).
 """
 
 from __future__ import annotations
@@ -71,6 +79,19 @@ def load_lightly() -> bool:
     load_overload._catdae_light = True
     cache.load_overload = load_overload
     return True
+
+
+def write_bytecode(root: Path | None = None) -> bool:
+    """Write the missing or stale bytecode of the modules under ``root`` (the catdae package
+    folder by default); False if it could not be done (a read-only install). Up to date, the
+    check costs about 2 ms. Never raises: the bytecode is only a saving."""
+    import compileall
+
+    root = Path(__file__).resolve().parent.parent if root is None else root
+    try:
+        return bool(compileall.compile_dir(str(root), quiet=2, workers=1))
+    except Exception:  # noqa: BLE001 - whatever goes wrong, the modules compile as before
+        return False
 
 
 def sources_digest(root: Path) -> str:

@@ -4,7 +4,14 @@ edit of catenary.py cannot leave element_mass.py's cached kernels running the ol
 
 from __future__ import annotations
 
-from catdae.element.cache import KERNEL_MODULES, purge_stale
+import importlib.util
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import catdae
+from catdae.element.cache import KERNEL_MODULES, purge_stale, write_bytecode
 
 
 def _tree(tmp_path):
@@ -81,6 +88,7 @@ def test_every_module_with_compiled_kernels_is_in_the_digest():
 
 _LIGHT_PROBE = r"""
 import sys
+from pathlib import Path
 import numpy as np
 from catdae.element.elements import Elements
 from numba import njit
@@ -117,3 +125,52 @@ def test_cached_kernels_load_without_numba_compiler_set_up_and_compiling_still_w
     tension = 1.0e6 * (10.01 / 10.0 - 1.0)
     assert abs(h[0] - 0.6 * tension) < 1e-6 * tension and abs(h[2] - 0.8 * tension) < 1e-6 * \
         tension and h[1] == 0.0
+
+
+def test_bytecode_is_written_for_missing_and_stale_modules_only(tmp_path):
+    """write_bytecode: each module's bytecode where it is missing or older than its source,
+    nothing where it is fresh, no error where the folder cannot be written."""
+    pkg = tmp_path / "pkg"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "a.py").write_text("A = 1\n")
+    (pkg / "sub" / "b.py").write_text("B = 2\n")
+    pycs = [Path(importlib.util.cache_from_source(str(p))) for p in (pkg / "a.py",
+                                                                       pkg / "sub" / "b.py")]
+    assert write_bytecode(pkg)
+    assert all(p.is_file() for p in pycs)
+    stamps = [p.stat().st_mtime_ns for p in pycs]
+    assert write_bytecode(pkg)
+    assert [p.stat().st_mtime_ns for p in pycs] == stamps  # fresh: not written again
+    (pkg / "a.py").write_text("A = 10  # changed\n")
+    os.utime(pkg / "a.py", ns=(stamps[0] + 10**9, stamps[0] + 10**9))
+    assert write_bytecode(pkg)
+    assert pycs[0].stat().st_mtime_ns != stamps[0] and pycs[1].stat().st_mtime_ns == stamps[1]
+    write_bytecode(tmp_path / "missing")  # a missing folder: no error
+
+
+def test_import_under_dont_write_bytecode_leaves_catdae_bytecode_fresh():
+    """With PYTHONDONTWRITEBYTECODE (python -B) an editable install compiled every catdae
+    module from source in every process (about 0.1 s of CPU); importing catdae writes its own
+    bytecode, so the next process reads it. Checked with a fresh ``python -B`` process after
+    one module's bytecode is removed: afterwards every catdae module has bytecode that
+    Python accepts for its source (the stamp of a timestamp .pyc: mtime and size)."""
+    root = Path(catdae.__file__).parent
+    if not os.access(root / "solvers", os.W_OK):  # a read-only install: nothing to write
+        return
+    gone = Path(importlib.util.cache_from_source(str(root / "solvers" / "order.py")))
+    gone.unlink(missing_ok=True)
+    proc = subprocess.run([sys.executable, "-B", "-c", "import catdae, sys; "
+                           "print(sys.flags.dont_write_bytecode)"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip() == "1"
+    stale = []
+    for p in root.rglob("*.py"):
+        c = Path(importlib.util.cache_from_source(str(p)))
+        head = c.read_bytes()[:16] if c.is_file() else b""
+        st = p.stat()
+        if (len(head) < 16 or int.from_bytes(head[4:8], "little") != 0
+                or int.from_bytes(head[8:12], "little") != int(st.st_mtime) & 0xFFFFFFFF
+                or int.from_bytes(head[12:16], "little") != st.st_size & 0xFFFFFFFF):
+            stale.append(str(p.relative_to(root)))
+    assert not stale, stale
