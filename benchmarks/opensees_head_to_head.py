@@ -141,14 +141,16 @@ def search_catdae(zref, args) -> list[dict]:
     meshes = [int(x) for x in args.meshes.split(",")]
     tols = [float(x) for x in args.tols.split(",")]
     rows = []
-    for mass, resolve in ((m, v) for m in masses for v in args.resolve.split(",")):
+    orders = [o if o == "auto" else int(o) for o in args.orders.split(",")]
+    for mass, resolve, order in ((m, v, o) for m in masses for v in args.resolve.split(",")
+                                 for o in orders):
         for n in meshes:
             best = None
             for rtol in tols:  # loosest first
-                r = catdae_inproc(n, rtol, mass, resolve=resolve)
+                r = catdae_inproc(n, rtol, mass, order, resolve=resolve)
                 r["err"] = sa.err(r["z"], zref)
                 rows.append(r)
-                print(f"catdae {mass} {resolve:6s} {n:4d} el rtol {rtol:.0e}: err "
+                print(f"catdae {mass} {resolve:6s} order {order} {n:4d} el rtol {rtol:.0e}: err "
                       f"{r['err']:.2e} m, CPU {r['cpu']:.2f} s, {r['steps']} steps, "
                       f"{r['res']} residuals, order {r['final_order']}", flush=True)
                 if best is not None and r["err"] > 0.8 * best:
@@ -245,7 +247,8 @@ def head_to_head(crows, orows, env, args) -> list[dict]:
 def label(r: dict) -> str:
     if r["code"] == "catdae":
         res = "" if r.get("resolve", "auto") == "auto" else f", resolve {r['resolve']}"
-        return f"catdae {r['mass']}{res}, {r['ne']} el, rtol {r['rtol']:.0e}"
+        order = "" if r.get("order", "auto") == "auto" else f", max_order {r['order']}"
+        return f"catdae {r['mass']}{res}{order}, {r['ne']} el, rtol {r['rtol']:.0e}"
     return f"OpenSees massType {r['mass_type']} ({OPS_TYPES.get(r['mass_type'], '?')}), " \
            f"{r['ne']} el, dt {r['dt']:g} s"
 
@@ -327,6 +330,8 @@ def main(argv=None) -> None:
     ap.add_argument("--tols", default="1e-3,3e-4,1e-4,3e-5,1e-5,3e-6")
     ap.add_argument("--resolve", default="auto,waves",
                     help="the transient step's resolve settings to search (docs/case-format.md)")
+    ap.add_argument("--orders", default="auto",
+                    help="the transient step's max_order settings to search: auto, 1-5")
     ap.add_argument("--ops-meshes-0", default="96,128,160,192,256")
     ap.add_argument("--ops-meshes-3", default="48,64,80,96,128,160,192,256")
     ap.add_argument("--max-ops-wall", type=float, default=200.0)

@@ -26,6 +26,7 @@ from catdae.model.loading import (  # noqa: F401  (re-exported)
 )
 from catdae.model.mass import MassMatrices
 from catdae.model.mesh import AXES, Mesh
+from catdae.model.scalar import minimize_bounded
 from catdae.model.settings import choose_mass_model
 
 
@@ -314,11 +315,8 @@ class Model(MassMatrices):
                     q[e, 0] = sv
                     return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
 
-                from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
-
-                best = minimize_scalar(neg, bounds=(lo, hi), method="bounded",
-                                       options={"xatol": 1e-10 * mesh.L0[e]})
-                best_sag = max(best_sag, -float(best.fun))
+                best = minimize_bounded(neg, lo, hi, xatol=1e-10 * mesh.L0[e])
+                best_sag = max(best_sag, -float(best[1]))
             sag[ci] = best_sag
         unstrained = np.bincount(mesh.cable_of_element, weights=mesh.L0 / mesh.thermal,
                                  minlength=nc)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from catdae.model.scalar import minimize_bounded, root_bracketed
+
 N_SAMPLE = 33  # points per element where the curve is sampled before refining
 
 
@@ -61,8 +63,6 @@ def clearances(model, X, state, ground, s, pts) -> dict[str, np.ndarray]:
     heights are z, a profile's stations x of the gravity frame, where the model is solved:
     along up and e1), ``clearance`` m, and where, ``clearance_s`` m (unstrained arc length
     at the reference temperature): the lowest sample refined on its element's exact curve."""
-    from scipy.optimize import minimize_scalar  # lazy: 0.5-1 s to import
-
     mesh = model.mesh
     nc = len(mesh.cable_names)
     out = {"clearance": np.full(nc, np.nan), "clearance_s": np.full(nc, np.nan)}
@@ -78,9 +78,9 @@ def clearances(model, X, state, ground, s, pts) -> dict[str, np.ndarray]:
             p = xi + _point(model, state, e, v)
             return float(p[2] - ground.height(p[0]))
 
-        best = minimize_scalar(above, bounds=(s[e, max(j - 1, 0)], s[e, min(j + 1, n_s - 1)]),
-                               method="bounded", options={"xatol": 1e-11 * mesh.L0[e]})
-        s_c, g = ((float(best.x), float(best.fun)) if best.fun < gap[e, j]
+        bx, bf = minimize_bounded(above, s[e, max(j - 1, 0)], s[e, min(j + 1, n_s - 1)],
+                                  xatol=1e-11 * mesh.L0[e])
+        s_c, g = ((float(bx), float(bf)) if bf < gap[e, j]
                   else (float(s[e, j]), float(gap[e, j])))
         out["clearance"][ci] = g
         out["clearance_s"][ci] = (mesh.s_start[e] + s_c) / mesh.thermal[e]
@@ -101,8 +101,6 @@ def _crossing(u: np.ndarray, target: float) -> tuple[int | None, int]:
 def _one_cable(model, X, state, els, s, p) -> dict[str, float]:
     """The span quantities of one cable: its elements ``els``, samples ``p`` (n, N, 3) at the
     arc lengths ``s`` (n_elem, N) of every element."""
-    from scipy.optimize import brentq, minimize_scalar  # lazy: 0.5-1 s to import
-
     mesh = model.mesh
     out = {}
     a, b = X[mesh.conn[els[0], 0]], X[mesh.conn[els[-1], 1]]
@@ -116,9 +114,9 @@ def _one_cable(model, X, state, els, s, p) -> dict[str, float]:
         if m is not None:
             e = int(els[m])
             xi = X[mesh.conn[e, 0]]
-            sv = brentq(lambda v: float((xi[:2] + _point(model, state, e, v)[:2] - a[:2])
-                                        @ u_dir) - 0.5 * ch,
-                        s[e, j], s[e, j + 1], xtol=1e-12 * mesh.L0[e])
+            sv = root_bracketed(lambda v: float((xi[:2] + _point(model, state, e, v)[:2]
+                                                 - a[:2]) @ u_dir) - 0.5 * ch,
+                                s[e, j], s[e, j + 1], xtol=1e-12 * mesh.L0[e])
             d = a + 0.5 * c - (xi + _point(model, state, e, sv))  # chord point - cable, (3,)
             lateral = d[:2] - (d[:2] @ u_dir) * u_dir
             out["sag_midspan"] = float(d[2])
@@ -129,10 +127,10 @@ def _one_cable(model, X, state, els, s, p) -> dict[str, float]:
     e = int(els[m])
     xi = X[mesh.conn[e, 0]]
     n_s = s.shape[1]
-    best = minimize_scalar(lambda v: float(xi[2] + _point(model, state, e, v)[2]),
-                           bounds=(s[e, max(j - 1, 0)], s[e, min(j + 1, n_s - 1)]),
-                           method="bounded", options={"xatol": 1e-11 * mesh.L0[e]})
-    s_low, z_low = ((float(best.x), float(best.fun)) if best.fun < z[m, j]
+    bx, bf = minimize_bounded(lambda v: float(xi[2] + _point(model, state, e, v)[2]),
+                              s[e, max(j - 1, 0)], s[e, min(j + 1, n_s - 1)],
+                              xatol=1e-11 * mesh.L0[e])
+    s_low, z_low = ((float(bx), float(bf)) if bf < z[m, j]
                     else (float(s[e, j]), float(z[m, j])))
     out["lowest_point_elevation"] = z_low
     out["lowest_point_s"] = (mesh.s_start[e] + s_low) / mesh.thermal[e]

@@ -15,11 +15,12 @@ second, racing again now and then (docs/theory.md §8.6).
 
 from __future__ import annotations
 
+import sys
 import time as _time
+import types
 import warnings
 
 import numpy as np
-from sksundae.ida import IDA
 
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
@@ -33,6 +34,51 @@ from catdae.solvers.order import (
 from catdae.solvers.record import OutputRecord, note
 from catdae.solvers.residual import TransientProblem
 from catdae.solvers.tolerance import error_weights, resolve_mode
+
+
+def _import_ida():
+    """sksundae's IDA, without importing all of scipy.optimize for one helper.
+
+    scikit-sundae 1.2's compiled IDA module imports ``group_columns`` from
+    ``scipy.optimize._numdiff`` at its own import (it colours a sparsity pattern for finite-
+    difference Jacobians, which catdae never asks for: it gives the iteration matrix), and that
+    imports the whole of scipy.optimize: about 0.19 s of CPU in every transient process
+    (benchmarks/startup.md). While sksundae is imported, that module name is held by a stand-in
+    whose ``group_columns`` imports the real one at its first call and which hands any other
+    name over to the real module; the stand-in is taken out of ``sys.modules`` right after, so
+    any later import of scipy.optimize is the real one. Where the stand-in does not do (another
+    sksundae), sksundae is imported the ordinary way."""
+    name = "scipy.optimize._numdiff"
+    if name in sys.modules or "sksundae.ida" in sys.modules:
+        from sksundae.ida import IDA
+        return IDA
+
+    def group_columns(*args, **kwargs):
+        from scipy.optimize._numdiff import group_columns as real
+        return real(*args, **kwargs)
+
+    def real_attribute(attr):  # another name asked of it: the real module from here on
+        import importlib
+        if sys.modules.get(name) is stand_in:
+            del sys.modules[name]
+        return getattr(importlib.import_module(name), attr)
+
+    stand_in = types.ModuleType(name)
+    stand_in.group_columns = group_columns
+    stand_in.__getattr__ = real_attribute
+    sys.modules[name] = stand_in
+    try:
+        from sksundae.ida import IDA
+    except ImportError:
+        sys.modules.pop(name, None)
+        from sksundae.ida import IDA
+    finally:
+        if sys.modules.get(name) is stand_in:
+            del sys.modules[name]
+    return IDA
+
+
+IDA = _import_ida()
 
 __all__ = ["IDA", "OrderChoice", "TransientProblem", "choose_solver", "run_transient"]
 
