@@ -25,6 +25,7 @@ MAX_KEY_PARTS = 64  # parts of one dotted TOML key (a.b.c has 3), judged before 
 MIN_TIME = 1e-9  # s: shortest step duration, output interval or ramp duration
 MAX_FREQUENCY = 1e9  # Hz, of a sine or cosine time function
 MAX_COORDINATE = 1e7  # m, of a node (10 000 km); far beyond it, squared lengths overflow
+MAX_DIAMETER = 1e7  # m, of a line: its area and volume would overflow far beyond it
 TABLE_ROOTS_ENV = "CATDAE_TABLE_ROOTS"  # more folders table files may be read from
 
 

@@ -11,7 +11,13 @@ from typing import Annotated, Any, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
-from catdae.case.limits import MAX_COORDINATE, MAX_ELEMENTS_PER_CABLE, MAX_FREQUENCY, MIN_TIME
+from catdae.case.limits import (
+    MAX_COORDINATE,
+    MAX_DIAMETER,
+    MAX_ELEMENTS_PER_CABLE,
+    MAX_FREQUENCY,
+    MIN_TIME,
+)
 
 STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
@@ -61,7 +67,7 @@ class MaterialSchema(BaseModel):
     damping: NonNeg = 0.0
     thermal_expansion: float = 0.0
     # fluid properties of the line (docs/case-format.md, "Water and air")
-    diameter: Pos | None = None
+    diameter: Annotated[float, Field(gt=0, le=MAX_DIAMETER)] | None = None
     drag_normal: NonNeg | None = None
     drag_axial: NonNeg | None = None
     added_mass_normal: NonNeg | None = None

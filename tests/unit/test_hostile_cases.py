@@ -191,6 +191,17 @@ def test_a_mesh_above_the_dof_limit_is_refused(tmp_path, capsys):
             tmp_path, capsys)
 
 
+def test_a_line_diameter_beyond_the_limit_is_refused(tmp_path, capsys):
+    """A diameter of 1e300 m overflowed the line's area (pi d^2 / 4) in the fluid model, a
+    RuntimeWarning deep in a run (found by the fuzz test on the jumper case); refused on read
+    since a line's diameter is at most 1e7 m (docs/case-format.md, limits)."""
+    water = "[water]\ndensity = 1025.0\nsurface = 5.0\ndepth = 50.0\n"
+    for d in (1e300, 1.1e7):
+        text = scene(water).replace("mass = 1.0\n", f"mass = 1.0\ndiameter = {d!r}\n", 1)
+        invalid(text, "materials.m.diameter", "expected a value <= 10000000.0", tmp_path,
+                capsys, subprocess_check=d == 1e300)
+
+
 # -- 5. names: step names are netCDF group names; no control characters; mesh-node spelling ----
 def test_unsafe_step_names_are_refused(tmp_path, capsys):
     for k, name in enumerate(["$x", ".", "a\\u0000b", "-a", "a/b", "a "]):
