@@ -23,7 +23,9 @@ class OrderChoice:
     at order 2 where ω_max / ω₁ > ``START_RATIO`` (it leaves the state free of the fast content
     that order 5 carries and order 2 must first damp), at order 5 otherwise. After the first
     window the other order runs one window from the current state (a new IDA) and takes over if
-    it measures fewer than ``MARGIN`` times the incumbent's steps per second. An order-2 window
+    it measures fewer than ``MARGIN`` times the incumbent's steps per second (where it does not,
+    the driver takes the trial back and the incumbent's IDA goes on from the trial's start:
+    ``catdae.solvers.transient``). An order-2 window
     is ``LONG2`` times ``WINDOW`` steps: from a state order 5 left it first damps the axial
     content (about 350 steps on issue 11's cable at 48 elements) before its own rate shows, and
     a first window at order 2 lasts ``FIRST_TIME`` times the lowest period 2π/ω₁ (the start of

@@ -157,6 +157,8 @@ class _Run:
         self._ida_options()
         self.outputs = OutputRecord(prob, self.times)
         self.n_steps = self.n_restarts = 0
+        self.n_rollbacks = 0  # races lost by the trial order: the incumbent went on
+        self._kept = None  # (IDA, t, k_done, n_restarts, fluid work) of a race's incumbent
         self.status = "completed"
 
     # ------------------------------------------------------------------ set-up
@@ -213,7 +215,10 @@ class _Run:
             "linear_solver": self.linsolver, "bandwidth": prob.bandwidth,
             "max_order": (oc.order if self.auto else int(step.max_order)),
             "max_order_setting": str(step.max_order),
-            "order_choice": oc.summary() if self.auto else "fixed by the step",
+            "order_choice": (oc.summary() + (
+                f"; {self.n_rollbacks} lost race(s) taken back: the incumbent went on from "
+                "the trial's start" if self.n_rollbacks else "")) if self.auto
+            else "fixed by the step",
             "mass_model": model.mass_model.name, "mass_model_setting": model.mass_model.setting,
             "mass_model_choice": model.mass_model.choice,
             "inertia": step.inertia if prob.lagrangian else
@@ -318,12 +323,36 @@ class _Run:
             elif self.order_choice is not None and self.order_choice.measuring:
                 new_order = self.order_choice.observe(t_int)
                 if new_order is not None:
-                    solver = self.make_solver(new_order)
-                    solver.init_step(t_int, y_last, yp_last)
+                    solver, t_int = self._change_order(solver, new_order, t_int, y_last,
+                                                       yp_last)
             bar.update(t_int)
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(self.step.name, self.snapshot(self.k_done))
                 last_write = _time.perf_counter()
+
+    def _change_order(self, solver, order: int, t_int: float, y_last, yp_last):
+        """The BDF order cap changed (OrderChoice): (the IDA to go on with, its time). A race's
+        trial order starts a new IDA, and the incumbent's is kept as it stands. Where the
+        incumbent wins, its IDA goes on from the trial's start, its history intact: the
+        trial's outputs are recorded again and the fluid's work taken back to that time (the
+        envelope keeps the trial's steps, states of the same motion within the tolerance).
+        A lost race so costs its trial window, not a new IDA's start at order 1 and the
+        damping of what the trial order left in the state (docs/theory.md §8.6). Where the
+        integrator was restarted during the trial (a stop), the incumbent starts anew."""
+        kept, self._kept = self._kept, None
+        work = self.outputs.work
+        if self.order_choice.mode == "trial":
+            self._kept = (solver, t_int, self.k_done, self.n_restarts,
+                          None if work is None else (work.t, work.W, work.P))
+        elif kept is not None and kept[3] == self.n_restarts:
+            solver, t_int, self.k_done, _, saved = kept
+            if saved is not None:
+                work.t, work.W, work.P = saved
+            self.n_rollbacks += 1
+            return solver, t_int
+        new = self.make_solver(order)
+        new.init_step(t_int, y_last, yp_last)
+        return new, t_int
 
     def _restart(self, solver, t_stop: float, y_last, before, more: bool) -> None:
         """A stop (support velocity jump, or the end of a record): a consistent restart
