@@ -4,7 +4,7 @@ scipy 1.17's array-API layer (``scipy._lib.array_api_compat.numpy``, imported by
 ``scipy.sparse``, ``scipy.linalg`` and scipy.optimize) copies numpy's namespace with ``from numpy
 import *``, and numpy's ``__all__`` names its lazily imported submodules ``f2py`` and ``testing``:
 the copy imports both (the Fortran wrapper generator with its Fortran parser, and numpy's test
-helpers with ``unittest``). Neither is used by a catdae run: about 0.06 s of CPU in every process
+helpers with ``unittest``). Neither is used by a catdae run: about 0.1 s of CPU in every process
 (benchmarks/startup.md). Here both are entered in ``sys.modules`` (and as numpy's attributes, as
 an import would) as ``importlib.util.LazyLoader`` modules: the copy takes the module object
 without looking inside, and the first attribute anybody reads (``numpy.testing.assert_allclose``,

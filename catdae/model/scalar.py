@@ -6,7 +6,7 @@ because importing scipy.optimize costs about 0.19 s of CPU in every process that
 (every static step computes the sag; benchmarks/startup.md), for a search of a few dozen
 evaluations. Both are textbook methods with a guaranteed bracket: golden-section search
 (Kiefer 1953) and the Illinois variant of regula falsi (Dowell & Jarratt 1971) with bisection
-as a safeguard. Tests check them against closed forms and against scipy's answers.
+as a safeguard. tests/unit/test_scalar.py checks them against closed forms.
 """
 
 from __future__ import annotations
