@@ -43,7 +43,8 @@ KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
                   "element/fluid_kinematics", "element/grounded", "solvers/axial_damping",
                   "solvers/envelope")
 _STAMP = "catdae-kernels.sha256"
-_OWN = str(Path(__file__).resolve().parents[1])  # the catdae package folder
+_ROOT = Path(__file__).resolve().parents[1]  # the catdae package folder
+_OWN = str(_ROOT)
 
 
 def load_lightly() -> bool:
@@ -87,7 +88,7 @@ def write_bytecode(root: Path | None = None) -> bool:
     check costs about 2 ms. Never raises: the bytecode is only a saving."""
     import compileall
 
-    root = Path(__file__).resolve().parent.parent if root is None else root
+    root = _ROOT if root is None else root
     try:
         return bool(compileall.compile_dir(str(root), quiet=2, workers=1))
     except Exception:  # noqa: BLE001 - whatever goes wrong, the modules compile as before
@@ -106,7 +107,7 @@ def purge_stale(root: Path | None = None) -> bool:
     """Delete the cached kernels of KERNEL_MODULES if their sources changed since they were
     cached; True if something was deleted. ``root`` is the package folder (``catdae/``); the
     digest is kept in ``root/__pycache__``. Never raises for file-system reasons."""
-    root = Path(__file__).resolve().parent.parent if root is None else root
+    root = _ROOT if root is None else root
     stamp_dir = root / "__pycache__"
     try:
         digest = sources_digest(root)

@@ -236,6 +236,11 @@ class Fluid:
             return None
         return cls(case, mesh, lumped_fraction, gauss_s, gauss_w)
 
+    @property
+    def has_current(self) -> bool:
+        """A current is given (uniform or a profile; its time function aside)."""
+        return self.c_kind != NONE
+
     # ---------------------------------------------------------------------------- time
     def _factors(self, t: float, waves: bool):
         cf = self.current_factor * (1.0 if self.c_time is None else

@@ -25,11 +25,10 @@ class FluidWork:
 
     def power(self, t: float, y: np.ndarray, yp: np.ndarray) -> float:
         prob = self.prob
-        fidx, fixed = prob.fidx, prob.model.fixed
-        xp, vp, ap = prob._supports(t)
-        X, V, A = self._X, self._V, self._A  # every dof is free or fixed: all overwritten
-        X[fidx], V[fidx], A[fidx] = y[0::2], y[1::2], yp[1::2]
-        X[fixed], V[fixed], A[fixed] = xp, vp, ap
+        V, A = prob.full_vectors(t, y[1::2], yp[1::2], out=(self._V, self._A))
+        X = self._X  # every dof is free or fixed: all overwritten
+        X[prob.fidx] = y[0::2]
+        X[prob.model.fixed] = prob._supports(t)[0]
         out = self.fluid.evaluate(t, X, V, A)[0]  # M_a A - f
         return -float(out @ V)
 

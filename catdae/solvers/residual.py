@@ -241,11 +241,12 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self._cache_t, self._cache_q, self._cache = t, np.array(q, copy=True), out
         return out
 
-    def full_vectors(self, t: float, v: np.ndarray, vd: np.ndarray):
+    def full_vectors(self, t: float, v: np.ndarray, vd: np.ndarray, out=None):
+        """Velocities and accelerations of every dof (n_dof,) from those of the unknowns and the
+        supports' at t; into ``out`` = (V, A) when given (every entry is overwritten)."""
         m = self.model
         _, vp, ap = self._supports(t)
-        V = np.zeros(self.n_dof)
-        A = np.zeros(self.n_dof)
+        V, A = (np.zeros(self.n_dof), np.zeros(self.n_dof)) if out is None else out
         V[self.fidx] = v
         A[self.fidx] = vd
         V[m.fixed] = vp

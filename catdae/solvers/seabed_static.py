@@ -43,8 +43,7 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
                            support_on)
     except ConvergenceError:
         pass
-    if model.fluid is not None and model.fluid.water is not None and \
-            model.fluid.water.current is not None:
+    if model.fluid is not None and model.fluid.has_current:
         try:
             return _current_ramp(model, zb, start, (t, load_steps, max_rounds, ztol, fscale,
                                                     support_on))
@@ -223,8 +222,7 @@ def _check_slack_resting(gm: GroundedModel, sol, fscale: float) -> None:
     """In a current, a resting element without tension: the drag along the resting part has
     taken its tension to zero before the anchor, and on a frictionless seabed the rest of it
     has nothing to hold it (the line would pile up at the anchor): no equilibrium, say so."""
-    fl = gm.fluid
-    if fl is None or fl.water is None or fl.water.current is None:
+    if gm.fluid is None or not gm.fluid.has_current:
         return
     resting = np.flatnonzero(gm.mode != g.FREE)
     if resting.size == 0:

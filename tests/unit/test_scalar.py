@@ -11,18 +11,15 @@ import pytest
 
 from catdae.model.scalar import minimize_bounded, root_bracketed
 
-from scene_toml import cable as cable_toml
-from scene_toml import load, scene, static_step, step
+from scene_toml import cable_scene, load, static_step, step
 
-CASE = scene(
-    head={"title": "No scipy.optimize", "source": "tests/unit/test_scalar.py"},
-    materials={"wire": {"EA": 3.4e7, "mass": 5.0}},
-    nodes={"A": (0.0, 0.0, 0.0), "B": (10.0, 0.0, 1.0)},
-    cables=[cable_toml("cable", material="wire", length=11.0, elements=4)],
-    extra=load("tap", [0.0, 20.0, -30.0], node="cable.2",
-               time={"kind": "ramp", "duration": 0.02}),
-    steps=static_step("first") + step("transient", "tapped", duration=0.04,
-                                      output_interval=0.01))
+# a wire of 4 elements tapped at its middle: a static and a short transient step
+CASE = cable_scene(B=(10.0, 0.0, 1.0), L0=11.0, EA=3.4e7, mass=5.0, elements=4,
+                   title="No scipy.optimize",
+                   extra=load("tap", [0.0, 20.0, -30.0], node="c.2",
+                              time={"kind": "ramp", "duration": 0.02}),
+                   steps=static_step("first") + step("transient", "tapped", duration=0.04,
+                                                     output_interval=0.01))
 
 
 @pytest.mark.parametrize("f, lo, hi, x_true", [
