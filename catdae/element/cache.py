@@ -39,9 +39,9 @@ import hashlib
 from pathlib import Path
 
 KERNEL_MODULES = ("element/catenary", "element/catenary_batch", "element/mass",
-                  "element/mass_gradient", "element/residual_kernel", "element/fluid_kernel",
-                  "element/fluid_kinematics", "element/grounded", "solvers/axial_damping",
-                  "solvers/envelope")
+                  "element/mass_gradient", "element/lagrange", "element/residual_kernel",
+                  "element/fluid_kernel", "element/fluid_kinematics", "element/grounded",
+                  "solvers/axial_damping", "solvers/envelope")
 _STAMP = "catdae-kernels.sha256"
 _ROOT = Path(__file__).resolve().parents[1]  # the catdae package folder
 _OWN = str(_ROOT)

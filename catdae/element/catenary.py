@@ -242,19 +242,26 @@ def _steep_start(c, l0, ea, w, lh, h):
 
 
 @njit(cache=True)
-def solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout):
+def solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout,
+              polish=True):
     """Newton for one element, warm-started from ``h`` when ``use_h``; a warm start that
-    fails (e.g. from a folded vertical state to a taut one) is retried cold."""
-    it, status = _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout)
+    fails (e.g. from a folded vertical state to a taut one) is retried cold.
+
+    ``polish``: once the Newton correction is below ``tol``, take it and evaluate the
+    flexibility there once more (h then exact to round-off); without it the last iterate is
+    kept, within ``tol`` of the solution, one flexibility evaluation cheaper (the transient
+    residual, docs/theory.md §8.2)."""
+    it, status = _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout,
+                             polish)
     if status == NOT_CONVERGED and use_h:
         it2, status = _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, False, tol, max_iter,
-                                  fout, kout)
+                                  fout, kout, polish)
         it += it2
     return it, status
 
 
 @njit(cache=True)
-def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout):
+def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout, polish):
     """Newton with backtracking for one element. Returns (iterations, status)."""
     d = np.empty(3)
     f = np.empty(6)
@@ -307,6 +314,9 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
         dn = np.sqrt(dn)
         if dn <= tol * (hn + hscale_extra):
             # the Newton correction is below the requested accuracy: take it and stop
+            if not polish:
+                status = CONVERGED
+                break
             for m in range(3):
                 ht[m] = h[m] + dh[m]
             if partial_solution(ht[0], ht[1], ht[2], w, ea, l0, ls, lf, k0, k1, dt, ft, True):

@@ -82,7 +82,7 @@ def _segment_grad(hx, hy, v, w, ea, a, b, f, fg):
 
 
 @njit(cache=True)
-def _partial_grad(h0, h1, h2, w, ea, s_end, ls, lf, k0, k1, f, fg):
+def partial_grad(h0, h1, h2, w, ea, s_end, ls, lf, k0, k1, f, fg):
     """G(s_end) (into f, upper triangle) and ∂G/∂h_m (into fg (6, 3)); see ``_partial``.
 
     A load inside the element shifts the tension by a constant, so ∂(hx, hy, v)/∂h = I on
@@ -215,7 +215,7 @@ def mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, p
     Gauss point and point mass. Returns False where a flexibility cannot be evaluated."""
     out[:, :] = 0.0
     dout[:, :, :] = 0.0
-    if not _partial_grad(he[0], he[1], he[2], w, ea, l0, ls, lf, k0, k1, f6, fg):
+    if not partial_grad(he[0], he[1], he[2], w, ea, l0, ls, lf, k0, k1, f6, fg):
         return False
     for k in range(3):
         for r in range(3):
@@ -233,10 +233,10 @@ def mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, p
         wt = gw_e[j]
         if wt == 0.0:
             continue
-        ok = _partial_grad(he[0], he[1], he[2], w, ea, gs_e[j], ls, lf, k0, k1, f6, fg) and ok
+        ok = partial_grad(he[0], he[1], he[2], w, ea, gs_e[j], ls, lf, k0, k1, f6, fg) and ok
         _add_ntn_grad(f6, fg, kk, dkk, scale_e * l0 * wt, out, dout, gm, bm, nm, dn)
     for p in range(pm0, pm1):
-        ok = _partial_grad(he[0], he[1], he[2], w, ea, pms[p], ls, lf, k0, k1, f6, fg) and ok
+        ok = partial_grad(he[0], he[1], he[2], w, ea, pms[p], ls, lf, k0, k1, f6, fg) and ok
         _add_ntn_grad(f6, fg, kk, dkk, pmm[p], out, dout, gm, bm, nm, dn)
     if fade != 1.0:
         for k in range(3):
@@ -244,3 +244,4 @@ def mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, p
                 for c in range(6):
                     dout[k, r, c] *= fade
     return ok
+

@@ -4,8 +4,10 @@ IDA calls the residual thousands of times per simulated second. Done as separate
 (scatter the unknowns, chords, element solve, mass, forces, gather) it spent as much time in
 Python between the compiled kernels as in them on meshes of tens of elements
 (benchmarks/speed_accuracy.md §7). ``residual_pass`` does all of it in one call and leaves the
-element state (tensions, flexibilities, stiffnesses, masses, ∂M/∂c) in the caller's buffers,
-where the iteration matrix and the outputs find it.
+element state (tensions, flexibilities, stiffnesses; the masses and ∂M/∂c where asked for) in
+the caller's buffers, where the iteration matrix, the envelope and the outputs find it. The
+passes IDA calls take the Lagrangian elements' inertia forces without their matrices
+(``free``, docs/theory.md §7.6).
 
 The element work is written out here rather than through ``mass.dynamics_one``: a call
 between compiled functions with some forty array arguments cost about 0.6 µs per element
@@ -20,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, solve_one
+from catdae.element.lagrange import lagrange_one
 from catdae.element.mass import dynamic_forces, dynamics_work, mass_one
 from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 
@@ -28,7 +31,7 @@ from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, w, ptr, ls, lf,
                   load_total, wl0, h, hw, use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm,
                   want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
-                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res, dm_skip):
+                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res, dm_skip, carried, free):
     """r_q = q' - v and r_v = M v' + C v + g + F - P on the free dofs, into ``res`` (2n,).
 
     y = [q, v] and yp interleaved per unknown; unknown k is full dof ``fidx[k]``; the fixed
@@ -42,10 +45,28 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
     output's pass, whose forces are read at the supports only, skips it where an element
     touches no supported dof; every residual IDA sees has none skipped.
 
+    ``free``: with ``want_dm``, the Lagrangian elements' M a and velocity terms go straight
+    into the forces (``lagrange_one``) and their ``me`` (zero) and ``dm`` (stale) are not
+    built; the iteration matrix and the outputs then need a pass without it.
+
+    ``carried`` (1,) bool: the buffers ``X``, ``hw``, ``kmat`` and ``stat`` hold a whole
+    successful pass (set here). Each taut element's Newton then starts from the tension carried
+    from that pass, hw + kmat (c - c_last), whose error is second order in the chord's change
+    (one Newton iteration fewer), where that change is below ``CARRY`` of the tension; else
+    from ``h`` (docs/theory.md §8.2).
+
     Returns False, with ``res`` untouched, where an element cannot be solved: the caller
     rejects the trial state.
     """
     n = fidx.shape[0]
+    ne = conn.shape[0]
+    carry = carried[0] and use_h
+    carried[0] = False
+    last = np.empty((ne, 3)) if carry else np.empty((0, 3))
+    if carry:  # the chords of the last pass, before X is overwritten
+        for e in range(ne):
+            for a in range(3):
+                last[e, a] = X[3 * conn[e, 1] + a] - X[3 * conn[e, 0] + a]
     for k in range(n):
         d = fidx[k]
         X[d] = y[2 * k]
@@ -58,19 +79,23 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         A[d] = ap[k]
     xw, g6, fg, dkk, gm, bm, fm, nm, dn = dynamics_work()
     chord = np.empty(3)
-    ne = conn.shape[0]
+    fx = np.zeros((ne, 6)) if free else np.zeros((0, 6))  # the matrix-free element forces
+    ve6 = np.empty(6)
+    ae6 = np.empty(6)
     for e in range(ne):
         i = 3 * conn[e, 0]
         j = 3 * conn[e, 1]
         for a in range(3):
             chord[a] = X[j + a] - X[i + a]
-            hw[e, a] = h[e, a]
+        if not (carry and stat[e] == CONVERGED and _carry_start(chord, last[e], hw[e], kmat[e])):
+            for a in range(3):
+                hw[e, a] = h[e, a]
         if not want_m:  # a lumped or constant mass: the solve alone
             its[e], stat[e] = solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
-                                         hw[e], use_h, tol, max_iter, fflat[e], kmat[e])
+                                         hw[e], use_h, tol, max_iter, fflat[e], kmat[e], False)
         else:
             its[e], stat[e] = solve_one(chord, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1],
-                                         hw[e], use_h, tol, max_iter, fflat[e], kmat[e])
+                                         hw[e], use_h, tol, max_iter, fflat[e], kmat[e], False)
             if stat[e] == NOT_CONVERGED:
                 return False
             k0, k1 = ptr[e], ptr[e + 1]
@@ -79,11 +104,20 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                 fade = 0.0
                 if stat[e] == CONVERGED and not dm_skip[e]:
                     fade = gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
-                if fade > 0.0:
+                if fade > 0.0 and free:
+                    for a in range(6):
+                        ve6[a] = V[edofs[e, a]]
+                        ae6[a] = A[edofs[e, a]] + alpha * V[edofs[e, a]]
+                    done = lagrange_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
+                                        gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
+                                        fade, scale, ve6, ae6, fx[e], g6, fg)
+                    if done:
+                        me[e, :, :] = 0.0
+                elif fade > 0.0:
                     done = mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
                                           gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
                                           fade, me[e], dm[e], g6, fg, dkk, gm, bm, nm, dn, fm)
-                if not done:
+                if not done and not free:
                     dm[e, :, :, :] = 0.0
             slack = stat[e] == SLACK
             if not done:
@@ -106,15 +140,42 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                 for r in range(6):
                     for c in range(6):
                         ce[e, r, c] *= scale
-            if want_dm:
+            if want_dm and not free:
                 for kk in range(3):
                     for r in range(6):
                         for c in range(6):
                             dm[e, kk, r, c] *= scale
-    dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm, want_dm, alpha,
-                    beta, V, A, force)
+    dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm,
+                    want_dm and not free, alpha, beta, V, A, force)
+    for e in range(fx.shape[0]):
+        for a in range(6):
+            force[edofs[e, a]] += fx[e, a]
     for k in range(n):
         d = fidx[k]
         res[2 * k] = yp[2 * k] - y[2 * k + 1]
         res[2 * k + 1] = force[d] + m_diag[d] * A[d] + v_diag[d] * V[d] - p_nodal[d]
+    carried[0] = True
+    return True
+
+
+CARRY = 0.25  # largest carried change of an element's end force, relative to it
+
+
+@njit(cache=True, inline="always")
+def _carry_start(chord, last, he, ke):
+    """he += ke (chord - last), the first-order change of the end force he solved at chord
+    ``last`` with stiffness ke, where it is below CARRY |he|; False (he untouched) else."""
+    d0 = chord[0] - last[0]
+    d1 = chord[1] - last[1]
+    d2 = chord[2] - last[2]
+    g0 = ke[0, 0] * d0 + ke[0, 1] * d1 + ke[0, 2] * d2
+    g1 = ke[1, 0] * d0 + ke[1, 1] * d1 + ke[1, 2] * d2
+    g2 = ke[2, 0] * d0 + ke[2, 1] * d1 + ke[2, 2] * d2
+    change = g0 * g0 + g1 * g1 + g2 * g2
+    size = he[0] * he[0] + he[1] * he[1] + he[2] * he[2]
+    if not change <= CARRY * CARRY * size:  # also where it is not finite
+        return False
+    he[0] += g0
+    he[1] += g1
+    he[2] += g2
     return True

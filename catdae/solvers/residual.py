@@ -134,6 +134,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self._its = np.zeros(ne, np.int64)
         self._stat = np.zeros(ne, np.int64)
         self._hw = np.zeros((ne, 3))
+        self._carried = np.zeros(1, np.bool_)  # the buffers hold a whole pass (the kernel's)
         self._h_cold = np.zeros((ne, 3))
         self._Xb = np.zeros(nd)
         self._Vb = np.zeros(nd)
@@ -142,6 +143,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         damped = self.damping.damped
         self._v_diag = (self.c_diag + self.alpha * self.m_diag) if damped else np.zeros(nd)
         self._buffers_at = None  # (t, q) whose element state the buffers hold
+        self._buffers_mats = False  # ... with the element matrices
         self._res_scratch = np.zeros(2 * self.n)
         ld = m.loading
         self._pm = m.elements._point_mass_csr((ld.mass_elem, ld.mass_s, ld.mass_value))
@@ -167,6 +169,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         el = m.elements
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         use_h = self.h is not None
+        free = self._want_dm and not output  # M a and g_e without the matrices (§7.6)
         ok = residual_pass(
             y, yp, self._fidx, self._fixed, xp, vp, ap, self._conn, self._edofs, self._Xb,
             self._Vb, self._Ab, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf, el._load_total,
@@ -175,7 +178,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
             self._use_m, self._want_c, self._use_c, self._want_dm, self._scale, self.alpha,
             self.beta, self.m_diag, self._v_diag, p, self._fflat, self._kmat, self._its,
             self._stat, self._me, self._ce, self._dm, self._force, res,
-            self._dm_skip_output if output else self._dm_skip_none)
+            self._dm_skip_output if output else self._dm_skip_none, self._carried, free)
         if not ok:
             self._buffers_at = None
             return False
@@ -186,6 +189,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = None if output else (t, np.array(y[0::2], copy=True))
+        self._buffers_mats = not free  # M_e and ∂M_e/∂c are in the buffers
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
         if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §17)
@@ -222,7 +226,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         if self._cache_t == t and np.array_equal(self._cache_q, q):
             return self._cache
         at = self._buffers_at
-        if at is not None and at[0] == t and np.array_equal(at[1], q):
+        if (at is not None and self._buffers_mats and at[0] == t
+                and np.array_equal(at[1], q)):
             out = self._conf_from_buffers()
             self._cache_t, self._cache_q, self._cache = t, at[1], out
             return out

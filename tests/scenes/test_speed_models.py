@@ -114,6 +114,90 @@ def test_analytic_mass_gradient_matches_complex_step():
     np.testing.assert_allclose(me, me2, rtol=1e-13, atol=0)
 
 
+def _six_elements():
+    """The six elements of the test above (taut, sagging, near-vertical, inclined, loaded, with
+    point masses inside): (elements, chords, Gauss points and weights, mass per length, point
+    masses)."""
+    L0 = np.array([10.0, 10.0, 3.0, 20.0, 2.0, 12.0])
+    EA = np.array([1e8, 1e6, 1e5, 1e8, 1e4, 5e7])
+    w = np.array([100.0, 10.0, 50.0, 300.0, 5.0, 80.0])
+    chord = np.array([[10.0004, 0.0, 0.0], [6.0, 2.0, -5.0], [0.1, 0.2, -2.9],
+                      [15.0, 3.0, 8.0], [1.5, 1.0, 0.5], [8.0, -4.0, 6.0]])
+    loads = PointLoads.from_lists([[], [(3.0, [0.0, 0.0, 50.0])],
+                                   [(1.0, [5.0, 0.0, 20.0]), (2.0, [0.0, 3.0, 10.0])], [], [],
+                                   [(6.0, [0.0, 0.0, 900.0])]])
+    xi = np.array([0.5 - np.sqrt(0.15), 0.5, 0.5 + np.sqrt(0.15)])
+    gs = xi[None, :] * L0[:, None]
+    gw = np.tile(np.array([5.0, 8.0, 5.0]) / 18.0, (L0.size, 1))
+    m = np.array([10.0, 2.0, 1.0, 30.0, 3.0, 8.0])
+    pm = (np.array([0, 3, 5]), np.array([4.0, 11.0, 6.0]), np.array([7.0, 20.0, 15.0]))
+    return Elements(L0, EA, w, loads), chord, gs, gw, m, pm
+
+
+def _lagrange(el, state, e, gs, gw, m, pm, fade, share, ve, ae):
+    """``lagrange_one`` of element e: share (M_e ae + fade g_e) without the matrices."""
+    from catdae.element.lagrange import lagrange_one
+
+    pmptr, pms, pmm = el._point_mass_csr(pm)
+    fe = np.full(6, np.nan)
+    ok = lagrange_one(state.h[e], state.K[e], el.L0[e], el.EA[e], el.w[e], el._ls, el._lf,
+                      el._ptr[e], el._ptr[e + 1], gs[e], gw[e], m[e], pmptr[e], pmptr[e + 1],
+                      pms, pmm, fade, share, ve, ae, fe, np.empty(6), np.empty((6, 3)))
+    assert ok
+    return fe
+
+
+def test_element_forces_without_the_matrices_equal_those_with_them():
+    """The residual's matrix-free element force share (M_e a + fade g_e) (docs/theory.md §7.6)
+    equals the one from the matrices M_e and ∂M_e/∂c (checked against complex steps above),
+    g_e = Σ_k ċ_k ∂M_e/∂c_k v - ½ vᵀ ∂M_e/∂c_k v [e_k; -e_k], with random velocities and
+    accelerations, to round-off; the matrices' ∂M_e/∂c carries the element's fade near zero
+    tension (§7.6), which is given to the matrix-free pass too."""
+    from catdae.element.mass_gradient import gradient_fade
+
+    el, chord, gs, gw, m, pm = _six_elements()
+    state, me, _, dm = el.solve_dynamic(chord, None, gs, gw, m, None, pm, gradient=True)
+    rng = np.random.default_rng(5)
+    for e in range(el.n):
+        ve, ae = rng.normal(size=6), rng.normal(size=6)
+        fade = gradient_fade(state.h[e], el.w[e], el.L0[e], el._ls, el._lf, el._ptr[e],
+                             el._ptr[e + 1])
+        share = 0.6
+        g = np.zeros(6)
+        for k in range(3):
+            qv = dm[e, k] @ ve
+            g += (ve[3 + k] - ve[k]) * qv
+            g[k] += 0.5 * ve @ qv
+            g[3 + k] -= 0.5 * ve @ qv
+        ref = share * (me[e] @ ae + g)  # dm carries the fade
+        fe = _lagrange(el, state, e, gs, gw, m, pm, fade, share, ve, ae)
+        np.testing.assert_allclose(fe, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_velocity_terms_without_the_matrices_balance_the_kinetic_power():
+    """vᵀ g_e = ½ vᵀ Ṁ_e v = d/dt (½ vᵀ M_e(c) v) at fixed v (docs/theory.md §7.6: the terms
+    that make the energy balance): the matrix-free g_e against a central difference of the
+    kinetic energy along ċ = v_j - v_i, the element re-solved by Newton at c ± δ ċ
+    (Richardson-extrapolated): an independent path through the solve and the mass."""
+    el, chord, gs, gw, m, pm = _six_elements()
+    state, _, _ = el.solve_dynamic(chord, None, gs, gw, m, None, pm)
+    rng = np.random.default_rng(9)
+    ve = rng.normal(size=(el.n, 6))
+    cdot = ve[:, 3:] - ve[:, :3]
+
+    def kinetic(step):
+        me = el.solve_dynamic(chord + step * cdot, state.h, gs, gw, m, None, pm)[1]
+        return 0.5 * np.einsum("ei,eij,ej->e", ve, me, ve)
+
+    def central(d):
+        return (kinetic(d) - kinetic(-d)) / (2 * d)
+
+    ref = (4 * central(1e-6) - central(2e-6)) / 3  # a chord change of about 1 µm
+    for e in range(el.n):
+        g = _lagrange(el, state, e, gs, gw, m, pm, 1.0, 1.0, ve[e], np.zeros(6))
+        assert ve[e] @ g == pytest.approx(ref[e], rel=1e-7)  # measured: < 1e-8
+
+
 # ----------------------------------------------------------------------------------------------
 # transients: the blend balances work and energy; the order choice converges
 # ----------------------------------------------------------------------------------------------
