@@ -263,13 +263,14 @@ def solve_one(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout,
 @njit(cache=True)
 def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kout, polish):
     """Newton with backtracking for one element. Returns (iterations, status)."""
-    d = np.empty(3)
-    f = np.empty(6)
-    dt = np.empty(3)
-    ft = np.empty(6)
-    ht = np.empty(3)
-    dh = np.empty(3)
-    kk = np.empty((3, 3))
+    buf = np.empty(24)  # one allocation for the work vectors (each one costs ~50 ns)
+    d = buf[0:3]
+    f = buf[3:9]
+    dt = buf[9:12]
+    ft = buf[12:18]
+    ht = buf[18:21]
+    dh = buf[21:24]
+    kk = kout  # K of the iterates; kout is set from the final flexibility below
     lc = np.sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2])
     # slack: weightless, no loads, chord not longer than L0 (no equilibrium with T > 0)
     if w == 0.0 and k1 == k0 and lc <= l0:

@@ -83,3 +83,15 @@ def tension_batch(h, w, ptr, ls, lf, s, tout):
             tout[e, j, 0] = tx
             tout[e, j, 1] = ty
             tout[e, j, 2] = tz
+
+
+@njit(cache=True)
+def end_tension_batch(h, load_total, w, l0, out):
+    """|h| and |h - Σ f_k + (0, 0, w L0)|, the tensions at both ends, into out (n, 2)."""
+    for e in range(h.shape[0]):
+        hx, hy, hz = h[e, 0], h[e, 1], h[e, 2]
+        out[e, 0] = np.sqrt(hx * hx + hy * hy + hz * hz)
+        jx = hx - load_total[e, 0]
+        jy = hy - load_total[e, 1]
+        jz = hz - load_total[e, 2] + w[e] * l0[e]
+        out[e, 1] = np.sqrt(jx * jx + jy * jy + jz * jz)

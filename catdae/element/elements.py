@@ -19,6 +19,7 @@ from catdae.element.catenary import (  # noqa: F401  (re-exported)
     STATUS_NAMES,
 )
 from catdae.element.catenary_batch import (  # noqa: F401  (re-exported)
+    end_tension_batch,
     energy_batch,
     partial_batch,
     solve_batch,
@@ -297,12 +298,8 @@ class Elements:
 
     def end_tensions(self, h) -> np.ndarray:
         """Tension at s = 0 and s = L0 (just inside the element), (n, 2) N."""
-        h = self._h(h)
-        hj = h - self._load_total  # the end force at j, r_j of end_forces
-        hj[:, 2] += self.w * self.L0
-        out = np.empty((self.n, 2))
-        out[:, 0] = np.sqrt(np.einsum("ij,ij->i", h, h))
-        out[:, 1] = np.sqrt(np.einsum("ij,ij->i", hj, hj))
+        out = np.empty((self.n, 2))  # at j: the end force r_j of end_forces
+        end_tension_batch(self._h(h), self._load_total, self.w, self.L0, out)
         return out
 
     def energies(self, h, xi, wi) -> np.ndarray:

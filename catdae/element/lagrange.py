@@ -4,8 +4,10 @@ derivatives, in registers, for the transient residual pass."""
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
+from catdae.element.catenary import partial_solution
 from catdae.element.mass_gradient import partial_grad
 
 
@@ -69,11 +71,12 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
     point: u = N ve = v_i + B Δv, N ae likewise; ∂B_k = ∂G_k K + G ∂K_k with
     ∂G_k = Σ_m ∂G/∂h_m K[m, k]; a_k = ∂B_k Δv, b_k = ∂B_kᵀ u = K ∂G_k u + ∂K_k G u; then
     Σ_k ċ_k ∂M/∂c_k ve = W [-Ḃᵀu + z - Bᵀz; Ḃᵀu + Bᵀz] with Ḃᵀu = Σ_k Δv_k b_k and
-    z = Σ_k Δv_k a_k, and ½ veᵀ ∂M/∂c_k ve = W u·a_k. Returns False (fe untouched) where a
-    flexibility cannot be evaluated. Work arrays: f6 (6,), fg (6, 3).
+    z = Σ_k Δv_k a_k, and ½ veᵀ ∂M/∂c_k ve = W u·a_k. Returns (ok, share ½ veᵀ M_e ve =
+    share ½ Σ W |u|², the kinetic energy); ok False (fe untouched) where a flexibility cannot be
+    evaluated. Work arrays: f6 (6,), fg (6, 3).
     """
     if not partial_grad(he[0], he[1], he[2], w, ea, l0, ls, lf, k0, k1, f6, fg):
-        return False
+        return False, 0.0
     K = (kk[0, 0], kk[0, 1], kk[0, 2], kk[1, 0], kk[1, 1], kk[1, 2], kk[2, 0], kk[2, 1],
          kk[2, 2])
     # ∂F/∂h_m and ∂K/∂c_k = -K ∂F_k K, ∂F_k = Σ_m ∂F/∂h_m K[m, k]
@@ -93,6 +96,7 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
     d2 = _mv(dK2, dv)
     acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # M ae
     lag = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # g_e
+    kin = 0.0
     nq = gs_e.shape[0]
     for q in range(nq + pm1 - pm0):
         if q < nq:
@@ -105,13 +109,14 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
             s = pms[pm0 + q - nq]
             wq = pmm[pm0 + q - nq]
         if not partial_grad(he[0], he[1], he[2], w, ea, s, ls, lf, k0, k1, f6, fg):
-            return False
+            return False, 0.0
         G = _sym9(f6[0], f6[1], f6[2], f6[3], f6[4], f6[5])
         B = _mm(G, K)
         bdv = _mv(B, dv)
         u = (vi[0] + bdv[0], vi[1] + bdv[1], vi[2] + bdv[2])
         bda = _mv(B, da)
         na = (ai[0] + bda[0], ai[1] + bda[1], ai[2] + bda[2])
+        kin += wq * _dot(u, u)
         btn = _mtv(B, na)  # W Nᵀ (N a) = W [na - Bᵀ na; Bᵀ na]
         acc = (acc[0] + wq * (na[0] - btn[0]), acc[1] + wq * (na[1] - btn[1]),
                acc[2] + wq * (na[2] - btn[2]), acc[3] + wq * btn[0], acc[4] + wq * btn[1],
@@ -160,4 +165,34 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
                lag[5] + wq * (btz[2] + bdu[2]) - h2)
     for i in range(6):
         fe[i] = share * (acc[i] + fade * lag[i])
-    return True
+    return True, 0.5 * share * kin
+
+
+@njit(cache=True)
+def kinetic_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm1, pms, pmm,
+                share, ve, d3, f6):
+    """share ½ veᵀ M_e ve = share ½ Σ_q W_q |v_i + B_q Δv|² of a solved taut element, without
+    M_e (an output's kinetic energy, where the element's forces are not read); NaN where a
+    flexibility cannot be evaluated. Work arrays: d3 (3,), f6 (6,)."""
+    K = (kk[0, 0], kk[0, 1], kk[0, 2], kk[1, 0], kk[1, 1], kk[1, 2], kk[2, 0], kk[2, 1],
+         kk[2, 2])
+    dv = (ve[3] - ve[0], ve[4] - ve[1], ve[5] - ve[2])
+    kdv = _mv(K, dv)
+    kin = 0.0
+    nq = gs_e.shape[0]
+    for q in range(nq + pm1 - pm0):
+        if q < nq:
+            wt = gw_e[q]
+            if wt == 0.0:
+                continue
+            s = gs_e[q]
+            wq = scale_e * l0 * wt
+        else:
+            s = pms[pm0 + q - nq]
+            wq = pmm[pm0 + q - nq]
+        if not partial_solution(he[0], he[1], he[2], w, ea, s, ls, lf, k0, k1, d3, f6, True):
+            return np.nan
+        bdv = _mv(_sym9(f6[0], f6[1], f6[2], f6[3], f6[4], f6[5]), kdv)  # B Δv = G (K Δv)
+        u = (ve[0] + bdv[0], ve[1] + bdv[1], ve[2] + bdv[2])
+        kin += wq * _dot(u, u)
+    return 0.5 * share * kin

@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, solve_one
-from catdae.element.lagrange import lagrange_one
+from catdae.element.lagrange import kinetic_one, lagrange_one
 from catdae.element.mass import dynamic_forces, dynamics_work, mass_one
 from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 
@@ -31,7 +31,8 @@ from catdae.element.mass_gradient import gradient_fade, mass_grad_one
 def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, w, ptr, ls, lf,
                   load_total, wl0, h, hw, use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm,
                   want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
-                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res, dm_skip, carried, free):
+                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res, dm_skip, carried, free,
+                  kin):
     """r_q = q' - v and r_v = M v' + C v + g + F - P on the free dofs, into ``res`` (2n,).
 
     y = [q, v] and yp interleaved per unknown; unknown k is full dof ``fidx[k]``; the fixed
@@ -47,7 +48,10 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
 
     ``free``: with ``want_dm``, the Lagrangian elements' M a and velocity terms go straight
     into the forces (``lagrange_one``) and their ``me`` (zero) and ``dm`` (stale) are not
-    built; the iteration matrix and the outputs then need a pass without it.
+    built; the iteration matrix then needs a pass without it. With ``free``, an element marked
+    in ``dm_skip`` (an output's pass: it touches no supported dof, whose forces alone are read)
+    gets no inertia force at all, only its kinetic energy. ``kin`` (n_elements, or empty): the
+    elements' kinetic energy ½ v_eᵀ M_e v_e of the consistent share, when given.
 
     ``carried`` (1,) bool: the buffers ``X``, ``hw``, ``kmat`` and ``stat`` hold a whole
     successful pass (set here). Each taut element's Newton then starts from the tension carried
@@ -82,7 +86,10 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
     fx = np.zeros((ne, 6)) if free else np.zeros((0, 6))  # the matrix-free element forces
     ve6 = np.empty(6)
     ae6 = np.empty(6)
+    want_kin = kin.shape[0] == ne
     for e in range(ne):
+        if want_kin:
+            kin[e] = 0.0
         i = 3 * conn[e, 0]
         j = 3 * conn[e, 1]
         for a in range(3):
@@ -102,17 +109,25 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
             done = False
             if want_dm:
                 fade = 0.0
-                if stat[e] == CONVERGED and not dm_skip[e]:
+                if stat[e] == CONVERGED and (free or not dm_skip[e]):
                     fade = gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
                 if fade > 0.0 and free:
                     for a in range(6):
                         ve6[a] = V[edofs[e, a]]
                         ae6[a] = A[edofs[e, a]] + alpha * V[edofs[e, a]]
-                    done = lagrange_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
-                                        gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
-                                        fade, scale, ve6, ae6, fx[e], g6, fg)
+                    if dm_skip[e]:  # an output's element off the supports: its energy alone
+                        ke = kinetic_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
+                                         gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
+                                         scale, ve6, xw, g6)
+                        done = np.isfinite(ke)
+                    else:
+                        done, ke = lagrange_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0,
+                                                k1, gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1],
+                                                pms, pmm, fade, scale, ve6, ae6, fx[e], g6, fg)
                     if done:
                         me[e, :, :] = 0.0
+                        if want_kin:
+                            kin[e] = ke
                 elif fade > 0.0:
                     done = mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
                                           gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
@@ -145,6 +160,14 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                     for r in range(6):
                         for c in range(6):
                             dm[e, kk, r, c] *= scale
+    if want_kin and want_m:  # the elements whose matrix was built (me zero where not)
+        for e in range(ne):
+            acc = 0.0
+            for r in range(6):
+                vr = V[edofs[e, r]]
+                for c in range(6):
+                    acc += vr * me[e, r, c] * V[edofs[e, c]]
+            kin[e] += 0.5 * acc
     dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm,
                     want_dm and not free, alpha, beta, V, A, force)
     for e in range(fx.shape[0]):

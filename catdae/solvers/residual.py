@@ -135,6 +135,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self._stat = np.zeros(ne, np.int64)
         self._hw = np.zeros((ne, 3))
         self._carried = np.zeros(1, np.bool_)  # the buffers hold a whole pass (the kernel's)
+        self._kin = np.zeros(ne)  # an output's kinetic energy of the consistent share, per element
+        self._no_kin = np.zeros(0)
         self._h_cold = np.zeros((ne, 3))
         self._Xb = np.zeros(nd)
         self._Vb = np.zeros(nd)
@@ -160,16 +162,16 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         """The residual at (t, y, yp) into ``res`` in one compiled pass; False (res untouched)
         where an element cannot be solved. The element state stays in the buffers for the
         iteration matrix and the outputs at the same (t, q). ``output``: for ``observe``,
-        which reads the forces at the supports only: ∂M/∂c (the Lagrange terms) only of the
-        elements that touch a supported dof, and the buffers not offered to the iteration
-        matrix or the envelope afterwards."""
+        which reads the forces at the supports only: the inertia forces only of the elements
+        that touch a supported dof, the elements' kinetic energies into ``_kin``, and the
+        buffers not offered to the iteration matrix or the envelope afterwards."""
         m = self.model
         xp, vp, ap = self._supports(t)
         m.set_time(t)
         el = m.elements
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         use_h = self.h is not None
-        free = self._want_dm and not output  # M a and g_e without the matrices (§7.6)
+        free = self._want_dm  # M a and g_e without the matrices (§7.6)
         ok = residual_pass(
             y, yp, self._fidx, self._fixed, xp, vp, ap, self._conn, self._edofs, self._Xb,
             self._Vb, self._Ab, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf, el._load_total,
@@ -178,7 +180,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
             self._use_m, self._want_c, self._use_c, self._want_dm, self._scale, self.alpha,
             self.beta, self.m_diag, self._v_diag, p, self._fflat, self._kmat, self._its,
             self._stat, self._me, self._ce, self._dm, self._force, res,
-            self._dm_skip_output if output else self._dm_skip_none, self._carried, free)
+            self._dm_skip_output if output else self._dm_skip_none, self._carried, free,
+            self._kin if output else self._no_kin)
         if not ok:
             self._buffers_at = None
             return False
@@ -316,7 +319,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         reaction = np.full(self.n_dof, np.nan)
         reaction[m.fixed] = f[m.fixed]
         kinetic = 0.5 * float(self.m_diag @ (V * V))
-        if self._use_m:
+        if self._want_m:  # left by evaluate, with or without the element matrices
+            kinetic += float(self._kin.sum())
+        elif self._use_m:  # a constant (linear) mass
             v_e = V[m.edofs]
             kinetic += 0.5 * float(np.einsum("ei,eij,ej->", v_e, self._me, v_e))
         strain, gravity = potential(m, X.reshape(-1, 3), h, t)

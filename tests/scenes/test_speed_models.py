@@ -136,23 +136,30 @@ def _six_elements():
 
 def _lagrange(el, state, e, gs, gw, m, pm, fade, share, ve, ae):
     """``lagrange_one`` of element e: share (M_e ae + fade g_e) without the matrices."""
-    from catdae.element.lagrange import lagrange_one
+    from catdae.element.lagrange import kinetic_one, lagrange_one
 
     pmptr, pms, pmm = el._point_mass_csr(pm)
     fe = np.full(6, np.nan)
-    ok = lagrange_one(state.h[e], state.K[e], el.L0[e], el.EA[e], el.w[e], el._ls, el._lf,
-                      el._ptr[e], el._ptr[e + 1], gs[e], gw[e], m[e], pmptr[e], pmptr[e + 1],
-                      pms, pmm, fade, share, ve, ae, fe, np.empty(6), np.empty((6, 3)))
+    ok, kinetic = lagrange_one(state.h[e], state.K[e], el.L0[e], el.EA[e], el.w[e], el._ls,
+                               el._lf, el._ptr[e], el._ptr[e + 1], gs[e], gw[e], m[e], pmptr[e],
+                               pmptr[e + 1], pms, pmm, fade, share, ve, ae, fe, np.empty(6),
+                               np.empty((6, 3)))
     assert ok
-    return fe
+    # an output's kinetic energy, where the element's forces are not read
+    alone = kinetic_one(state.h[e], state.K[e], el.L0[e], el.EA[e], el.w[e], el._ls, el._lf,
+                        el._ptr[e], el._ptr[e + 1], gs[e], gw[e], m[e], pmptr[e], pmptr[e + 1],
+                        pms, pmm, share, ve, np.empty(3), np.empty(6))
+    assert alone == pytest.approx(kinetic, rel=1e-13)
+    return fe, kinetic
 
 
 def test_element_forces_without_the_matrices_equal_those_with_them():
     """The residual's matrix-free element force share (M_e a + fade g_e) (docs/theory.md §7.6)
     equals the one from the matrices M_e and ∂M_e/∂c (checked against complex steps above),
     g_e = Σ_k ċ_k ∂M_e/∂c_k v - ½ vᵀ ∂M_e/∂c_k v [e_k; -e_k], with random velocities and
-    accelerations, to round-off; the matrices' ∂M_e/∂c carries the element's fade near zero
-    tension (§7.6), which is given to the matrix-free pass too."""
+    accelerations, to round-off, and so does its kinetic energy ½ share vᵀ M_e v (with the pass
+    that computes that alone, for outputs); the matrices' ∂M_e/∂c carries the element's fade
+    near zero tension (§7.6), which is given to the matrix-free pass too."""
     from catdae.element.mass_gradient import gradient_fade
 
     el, chord, gs, gw, m, pm = _six_elements()
@@ -170,8 +177,9 @@ def test_element_forces_without_the_matrices_equal_those_with_them():
             g[k] += 0.5 * ve @ qv
             g[3 + k] -= 0.5 * ve @ qv
         ref = share * (me[e] @ ae + g)  # dm carries the fade
-        fe = _lagrange(el, state, e, gs, gw, m, pm, fade, share, ve, ae)
+        fe, kinetic = _lagrange(el, state, e, gs, gw, m, pm, fade, share, ve, ae)
         np.testing.assert_allclose(fe, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+        assert kinetic == pytest.approx(0.5 * share * ve @ me[e] @ ve, rel=1e-12)
 
 
 def test_velocity_terms_without_the_matrices_balance_the_kinetic_power():
@@ -194,7 +202,7 @@ def test_velocity_terms_without_the_matrices_balance_the_kinetic_power():
 
     ref = (4 * central(1e-6) - central(2e-6)) / 3  # a chord change of about 1 µm
     for e in range(el.n):
-        g = _lagrange(el, state, e, gs, gw, m, pm, 1.0, 1.0, ve[e], np.zeros(6))
+        g = _lagrange(el, state, e, gs, gw, m, pm, 1.0, 1.0, ve[e], np.zeros(6))[0]
         assert ve[e] @ g == pytest.approx(ref[e], rel=1e-7)  # measured: < 1e-8
 
 
