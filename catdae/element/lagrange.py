@@ -41,13 +41,14 @@ def _sym9(f0, f1, f2, f3, f4, f5):
 
 @njit(cache=True, inline="always")
 def _comb(a, x, b, y, c, z):
-    """a x + b y + c z for 3-tuples x, y, z (or 9-tuples: then element-wise, 9 entries)."""
+    """a x + b y + c z for 3-tuples x, y, z."""
     return (a * x[0] + b * y[0] + c * z[0], a * x[1] + b * y[1] + c * z[1],
             a * x[2] + b * y[2] + c * z[2])
 
 
 @njit(cache=True, inline="always")
 def _comb9(a, x, b, y, c, z):
+    """a x + b y + c z for 9-tuples (3x3 matrices) x, y, z."""
     return (a * x[0] + b * y[0] + c * z[0], a * x[1] + b * y[1] + c * z[1],
             a * x[2] + b * y[2] + c * z[2], a * x[3] + b * y[3] + c * z[3],
             a * x[4] + b * y[4] + c * z[4], a * x[5] + b * y[5] + c * z[5],

@@ -244,4 +244,3 @@ def mass_grad_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, p
                 for c in range(6):
                     dout[k, r, c] *= fade
     return ok
-
