@@ -1,6 +1,8 @@
 """Compiled batch kernels of the catenary element (docs/theory.md §2-5): the element loop
 over a mesh for the end forces and stiffness, the partial flexibility and positions along the
-element, the energies and the tensions. One element's relations are in ``catenary``."""
+element, the energies and the tensions, and two relations of one element that the transient
+kernels share (the end force carried to first order, the end tensions). The other relations of
+one element are in ``catenary``."""
 
 from __future__ import annotations
 
@@ -8,6 +10,37 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import partial_solution, solve_one
+
+
+@njit(cache=True, inline="always")
+def carry_tension(chord, last, he, ke, limit):
+    """he += ke (chord - last): the end force he, solved at chord ``last`` with stiffness ke,
+    carried to first order to ``chord``, where that change is at most ``limit`` |he|; False
+    (he untouched) else, or where it is not finite."""
+    d0 = chord[0] - last[0]
+    d1 = chord[1] - last[1]
+    d2 = chord[2] - last[2]
+    g0 = ke[0, 0] * d0 + ke[0, 1] * d1 + ke[0, 2] * d2
+    g1 = ke[1, 0] * d0 + ke[1, 1] * d1 + ke[1, 2] * d2
+    g2 = ke[2, 0] * d0 + ke[2, 1] * d1 + ke[2, 2] * d2
+    change = g0 * g0 + g1 * g1 + g2 * g2
+    if not change <= limit * limit * (he[0] * he[0] + he[1] * he[1] + he[2] * he[2]):
+        return False
+    he[0] += g0
+    he[1] += g1
+    he[2] += g2
+    return True
+
+
+@njit(cache=True, inline="always")
+def end_tensions(he, load_total_e, w, l0):
+    """(|h|, |h - Σ f_k + (0, 0, w L0)|): the tensions just inside both ends of an element
+    whose end force at i is he (the second is r_j of the end forces, §4)."""
+    jx = he[0] - load_total_e[0]
+    jy = he[1] - load_total_e[1]
+    jz = he[2] - load_total_e[2] + w * l0
+    return (np.sqrt(he[0] * he[0] + he[1] * he[1] + he[2] * he[2]),
+            np.sqrt(jx * jx + jy * jy + jz * jz))
 
 
 @njit(cache=True)
@@ -89,9 +122,4 @@ def tension_batch(h, w, ptr, ls, lf, s, tout):
 def end_tension_batch(h, load_total, w, l0, out):
     """|h| and |h - Σ f_k + (0, 0, w L0)|, the tensions at both ends, into out (n, 2)."""
     for e in range(h.shape[0]):
-        hx, hy, hz = h[e, 0], h[e, 1], h[e, 2]
-        out[e, 0] = np.sqrt(hx * hx + hy * hy + hz * hz)
-        jx = hx - load_total[e, 0]
-        jy = hy - load_total[e, 1]
-        jz = hz - load_total[e, 2] + w[e] * l0[e]
-        out[e, 1] = np.sqrt(jx * jx + jy * jy + jz * jz)
+        out[e, 0], out[e, 1] = end_tensions(h[e], load_total[e], w[e], l0[e])

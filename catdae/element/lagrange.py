@@ -57,6 +57,15 @@ def _comb9(a, x, b, y, c, z):
 
 
 @njit(cache=True, inline="always")
+def _quadrature_point(q, nq, gs_e, gw_e, scale_e, l0, pm0, pms, pmm):
+    """(s, W) of an element's quadrature point q: the Gauss points (W = scale L0 w_g) first,
+    then the point masses inside it (W = m_p); W = 0 for a Gauss point of zero weight."""
+    if q < nq:
+        return gs_e[q], scale_e * l0 * gw_e[q]
+    return pms[pm0 + q - nq], pmm[pm0 + q - nq]
+
+
+@njit(cache=True, inline="always")
 def _dot(x, y):
     return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
 
@@ -100,15 +109,9 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
     kin = 0.0
     nq = gs_e.shape[0]
     for q in range(nq + pm1 - pm0):
-        if q < nq:
-            wt = gw_e[q]
-            if wt == 0.0:
-                continue
-            s = gs_e[q]
-            wq = scale_e * l0 * wt
-        else:
-            s = pms[pm0 + q - nq]
-            wq = pmm[pm0 + q - nq]
+        s, wq = _quadrature_point(q, nq, gs_e, gw_e, scale_e, l0, pm0, pms, pmm)
+        if wq == 0.0:
+            continue
         if not partial_grad(he[0], he[1], he[2], w, ea, s, ls, lf, k0, k1, f6, fg):
             return False, 0.0
         G = _sym9(f6[0], f6[1], f6[2], f6[3], f6[4], f6[5])
@@ -182,15 +185,9 @@ def kinetic_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm1
     kin = 0.0
     nq = gs_e.shape[0]
     for q in range(nq + pm1 - pm0):
-        if q < nq:
-            wt = gw_e[q]
-            if wt == 0.0:
-                continue
-            s = gs_e[q]
-            wq = scale_e * l0 * wt
-        else:
-            s = pms[pm0 + q - nq]
-            wq = pmm[pm0 + q - nq]
+        s, wq = _quadrature_point(q, nq, gs_e, gw_e, scale_e, l0, pm0, pms, pmm)
+        if wq == 0.0:
+            continue
         if not partial_solution(he[0], he[1], he[2], w, ea, s, ls, lf, k0, k1, d3, f6, True):
             return np.nan
         bdv = _mv(_sym9(f6[0], f6[1], f6[2], f6[3], f6[4], f6[5]), kdv)  # B Δv = G (K Δv)

@@ -22,36 +22,36 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, solve_one
+from catdae.element.catenary_batch import carry_tension
 from catdae.element.lagrange import kinetic_one, lagrange_one
-from catdae.element.mass import dynamic_forces, dynamics_work, mass_one
-from catdae.element.mass_gradient import gradient_fade, mass_grad_one
+from catdae.element.mass import dynamic_forces, mass_one
+from catdae.element.mass_gradient import gradient_fade
+
+CARRY = 0.25  # largest carried change of an element's end force, relative to it
 
 
 @njit(cache=True)
 def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, w, ptr, ls, lf,
                   load_total, wl0, h, hw, use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm,
                   want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
-                  p_nodal, fflat, kmat, its, stat, me, ce, dm, force, res, dm_skip, carried, free,
-                  kin):
+                  p_nodal, fflat, kmat, its, stat, me, ce, force, res, dm_skip, carried, kin):
     """r_q = q' - v and r_v = M v' + C v + g + F - P on the free dofs, into ``res`` (2n,).
 
     y = [q, v] and yp interleaved per unknown; unknown k is full dof ``fidx[k]``; the fixed
     dofs ``fixed`` have positions, velocities and accelerations ``xp, vp, ap``. The element
-    tensions start from ``h`` and are solved into ``hw``. ``want_m``/``want_c``/``want_dm``:
-    build the consistent mass, material damping and ∂M/∂c of the elements (times ``scale``:
+    tensions start from ``h`` and are solved into ``hw``. ``want_m``/``want_c``: build the
+    consistent mass and material damping of the elements into ``me``/``ce`` (times ``scale``:
     the consistent share of a blended mass); ``use_m``/``use_c``: use ``me``/``ce`` in the
     forces (given, when constant). ``m_diag`` and ``v_diag`` are the diagonal mass and the
-    diagonal damping (lumped parts, Rayleigh α M), ``p_nodal`` the nodal loads. ``dm_skip``
-    (n_elements,): elements whose ∂M/∂c is left out (zero; their mass built without it): an
-    output's pass, whose forces are read at the supports only, skips it where an element
-    touches no supported dof; every residual IDA sees has none skipped.
+    diagonal damping (lumped parts, Rayleigh α M), ``p_nodal`` the nodal loads.
 
-    ``free``: with ``want_dm``, the Lagrangian elements' M a and velocity terms go straight
-    into the forces (``lagrange_one``) and their ``me`` (zero) and ``dm`` (stale) are not
-    built; the iteration matrix then needs a pass without it. With ``free``, an element marked
-    in ``dm_skip`` (an output's pass: it touches no supported dof, whose forces alone are read)
-    gets no inertia force at all, only its kinetic energy. ``kin`` (n_elements, or empty): the
-    elements' kinetic energy ½ v_eᵀ M_e v_e of the consistent share, when given.
+    ``want_dm`` (the Lagrangian velocity terms): the taut elements' M a and velocity terms go
+    straight into the forces (``lagrange_one``, docs/theory.md §7.6) and their ``me`` is not
+    built (left as it was); the iteration matrix builds the matrices itself. ``dm_skip``
+    (n_elements,): elements that get no inertia force at all, only their kinetic energy (an
+    output's pass, whose forces are read at the supports only, marks those that touch no
+    supported dof; every residual IDA sees has none marked). ``kin`` (n_elements, or empty):
+    the elements' kinetic energy ½ v_eᵀ M_e v_e of the consistent share, when given.
 
     ``carried`` (1,) bool: the buffers ``X``, ``hw``, ``kmat`` and ``stat`` hold a whole
     successful pass (set here). Each taut element's Newton then starts from the tension carried
@@ -81,9 +81,12 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         X[d] = xp[k]
         V[d] = vp[k]
         A[d] = ap[k]
-    xw, g6, fg, dkk, gm, bm, fm, nm, dn = dynamics_work()
+    xw = np.empty(3)  # work arrays of the element kernels
+    g6 = np.empty(6)
+    fg = np.empty((6, 3))
     chord = np.empty(3)
-    fx = np.zeros((ne, 6)) if free else np.zeros((0, 6))  # the matrix-free element forces
+    fx = np.zeros((ne, 6)) if want_dm else np.zeros((0, 6))  # the matrix-free inertia forces
+    freed = np.zeros(ne, np.bool_)  # elements whose inertia is in fx, their me not built
     ve6 = np.empty(6)
     ae6 = np.empty(6)
     want_kin = kin.shape[0] == ne
@@ -94,7 +97,8 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         j = 3 * conn[e, 1]
         for a in range(3):
             chord[a] = X[j + a] - X[i + a]
-        if not (carry and stat[e] == CONVERGED and _carry_start(chord, last[e], hw[e], kmat[e])):
+        carried_e = carry and stat[e] == CONVERGED
+        if not (carried_e and carry_tension(chord, last[e], hw[e], kmat[e], CARRY)):
             for a in range(3):
                 hw[e, a] = h[e, a]
         if not want_m:  # a lumped or constant mass: the solve alone
@@ -107,11 +111,9 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                 return False
             k0, k1 = ptr[e], ptr[e + 1]
             done = False
-            if want_dm:
-                fade = 0.0
-                if stat[e] == CONVERGED and (free or not dm_skip[e]):
-                    fade = gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
-                if fade > 0.0 and free:
+            if want_dm and stat[e] == CONVERGED:
+                fade = gradient_fade(hw[e], w[e], l0[e], ls, lf, k0, k1)
+                if fade > 0.0:
                     for a in range(6):
                         ve6[a] = V[edofs[e, a]]
                         ae6[a] = A[edofs[e, a]] + alpha * V[edofs[e, a]]
@@ -125,15 +127,9 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                                                 k1, gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1],
                                                 pms, pmm, fade, scale, ve6, ae6, fx[e], g6, fg)
                     if done:
-                        me[e, :, :] = 0.0
+                        freed[e] = True
                         if want_kin:
                             kin[e] = ke
-                elif fade > 0.0:
-                    done = mass_grad_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
-                                          gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
-                                          fade, me[e], dm[e], g6, fg, dkk, gm, bm, nm, dn, fm)
-                if not done and not free:
-                    dm[e, :, :, :] = 0.0
             slack = stat[e] == SLACK
             if not done:
                 mass_one(hw[e], kmat[e], slack, l0[e], ea[e], w[e], ls, lf, k0, k1, gs[e],
@@ -147,7 +143,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
             if not np.isfinite(hw[e, a]):
                 return False
         if scale != 1.0:
-            if want_m:
+            if want_m and not freed[e]:
                 for r in range(6):
                     for c in range(6):
                         me[e, r, c] *= scale
@@ -155,21 +151,28 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                 for r in range(6):
                     for c in range(6):
                         ce[e, r, c] *= scale
-            if want_dm and not free:
-                for kk in range(3):
-                    for r in range(6):
-                        for c in range(6):
-                            dm[e, kk, r, c] *= scale
-    if want_kin and want_m:  # the elements whose matrix was built (me zero where not)
+    if want_m:  # the elements whose matrix was built: kinetic energy, and M (a + α v) into fx
         for e in range(ne):
-            acc = 0.0
+            if freed[e]:
+                continue
             for r in range(6):
-                vr = V[edofs[e, r]]
-                for c in range(6):
-                    acc += vr * me[e, r, c] * V[edofs[e, c]]
-            kin[e] += 0.5 * acc
-    dynamic_forces(edofs, hw, load_total, wl0, me, use_m, ce, use_c, kmat, dm,
-                    want_dm and not free, alpha, beta, V, A, force)
+                ve6[r] = V[edofs[e, r]]
+                ae6[r] = A[edofs[e, r]] + alpha * ve6[r]
+            if want_kin:
+                acc = 0.0
+                for r in range(6):
+                    for c in range(6):
+                        acc += ve6[r] * me[e, r, c] * ve6[c]
+                kin[e] += 0.5 * acc
+            if want_dm:
+                for r in range(6):
+                    acc = 0.0
+                    for c in range(6):
+                        acc += me[e, r, c] * ae6[c]
+                    fx[e, r] += acc
+    # the element matrices in fx where the Lagrangian terms are (no ∂M/∂c matrices here)
+    dynamic_forces(edofs, hw, load_total, wl0, me, use_m and not want_dm, ce, use_c, kmat,
+                    np.empty((0, 3, 6, 6)), False, alpha, beta, V, A, force)
     for e in range(fx.shape[0]):
         for a in range(6):
             force[edofs[e, a]] += fx[e, a]
@@ -178,27 +181,4 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         res[2 * k] = yp[2 * k] - y[2 * k + 1]
         res[2 * k + 1] = force[d] + m_diag[d] * A[d] + v_diag[d] * V[d] - p_nodal[d]
     carried[0] = True
-    return True
-
-
-CARRY = 0.25  # largest carried change of an element's end force, relative to it
-
-
-@njit(cache=True, inline="always")
-def _carry_start(chord, last, he, ke):
-    """he += ke (chord - last), the first-order change of the end force he solved at chord
-    ``last`` with stiffness ke, where it is below CARRY |he|; False (he untouched) else."""
-    d0 = chord[0] - last[0]
-    d1 = chord[1] - last[1]
-    d2 = chord[2] - last[2]
-    g0 = ke[0, 0] * d0 + ke[0, 1] * d1 + ke[0, 2] * d2
-    g1 = ke[1, 0] * d0 + ke[1, 1] * d1 + ke[1, 2] * d2
-    g2 = ke[2, 0] * d0 + ke[2, 1] * d1 + ke[2, 2] * d2
-    change = g0 * g0 + g1 * g1 + g2 * g2
-    size = he[0] * he[0] + he[1] * he[1] + he[2] * he[2]
-    if not change <= CARRY * CARRY * size:  # also where it is not finite
-        return False
-    he[0] += g0
-    he[1] += g1
-    he[2] += g2
     return True

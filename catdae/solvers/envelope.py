@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import NOT_CONVERGED, solve_one
-from catdae.element.catenary_batch import solve_batch
+from catdae.element.catenary_batch import carry_tension, end_tensions, solve_batch
 from catdae.solvers.axial_damping import element_g, unit_chord
 
 CARRY = 1e-4  # largest relative change of an end force carried to first order
@@ -70,7 +70,7 @@ def _carry(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf, loa
     for k in range(fixed.shape[0]):
         X[fixed[k]] = xp[k]
         V[fixed[k]] = vp[k]
-    dc = np.empty(3)
+    cb = np.empty(3)
     c = np.empty(3)
     h = np.empty(3)
     ge = np.empty(3)
@@ -80,20 +80,12 @@ def _carry(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf, loa
     for e in range(conn.shape[0]):
         i = 3 * conn[e, 0]
         j = 3 * conn[e, 1]
-        change = 0.0
         for a in range(3):
             c[a] = X[j + a] - X[i + a]
-            dc[a] = c[a] - (xb[j + a] - xb[i + a])
-        for a in range(3):
-            s = 0.0
-            for b in range(3):
-                s += kb[e, a, b] * dc[b]
-            h[a] = hb[e, a] + s
-            change += s * s
+            cb[a] = xb[j + a] - xb[i + a]
+            h[a] = hb[e, a]
             ge[a] = g[e, a]
-        if change > CARRY * CARRY * (hb[e, 0] ** 2 + hb[e, 1] ** 2 + hb[e, 2] ** 2):
-            for a in range(3):
-                h[a] = hb[e, a]
+        if not carry_tension(c, cb, h, kb[e], CARRY):
             _its, status = solve_one(c, l0[e], ea[e], w[e], ls, lf, ptr[e], ptr[e + 1], h,
                                       True, 1e-12, 100, f6, k33)
             if status == NOT_CONVERGED:
@@ -107,11 +99,9 @@ def _carry(y, fidx, fixed, xp, vp, conn, xb, hb, kb, l0, ea, w, ptr, ls, lf, loa
         for a in range(3):
             rate += ge[a] * (V[j + a] - V[i + a])
         visc = cd[e] * rate
-        out[e, 0] = np.sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) + visc
-        hx = h[0] - load_total[e, 0]
-        hy = h[1] - load_total[e, 1]
-        hz = h[2] - load_total[e, 2] + w[e] * l0[e]
-        out[e, 1] = np.sqrt(hx * hx + hy * hy + hz * hz) + visc
+        t_i, t_j = end_tensions(h, load_total[e], w[e], l0[e])
+        out[e, 0] = t_i + visc
+        out[e, 1] = t_j + visc
     return solved
 
 

@@ -125,7 +125,6 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
                     np.zeros((ne, 6, 6)) if consistent else self._dummy3)
         self._ce = (m.linear_element_mass(damping=True) if mm.linear and self.material else
                     np.zeros((ne, 6, 6)) if self._want_c else self._dummy3)
-        self._dm = np.zeros((ne, 3, 6, 6)) if self._want_dm else self._dummy4
         self._dm_skip_none = np.zeros(ne, np.bool_)
         # an output reads the forces at the supports only (reactions)
         self._dm_skip_output = ~np.isin(m.edofs, m.fixed).any(axis=1)
@@ -145,7 +144,6 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         damped = self.damping.damped
         self._v_diag = (self.c_diag + self.alpha * self.m_diag) if damped else np.zeros(nd)
         self._buffers_at = None  # (t, q) whose element state the buffers hold
-        self._buffers_mats = False  # ... with the element matrices
         self._res_scratch = np.zeros(2 * self.n)
         ld = m.loading
         self._pm = m.elements._point_mass_csr((ld.mass_elem, ld.mass_s, ld.mass_value))
@@ -171,7 +169,6 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         el = m.elements
         p = self._p_const if self._p_const is not None else m.nodal_load(t)
         use_h = self.h is not None
-        free = self._want_dm  # M a and g_e without the matrices (§7.6)
         ok = residual_pass(
             y, yp, self._fidx, self._fixed, xp, vp, ap, self._conn, self._edofs, self._Xb,
             self._Vb, self._Ab, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf, el._load_total,
@@ -179,8 +176,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
             m.gauss_s, m.gauss_w, m.mesh.m, m.mesh.c, *self._pm, self._want_m,
             self._use_m, self._want_c, self._use_c, self._want_dm, self._scale, self.alpha,
             self.beta, self.m_diag, self._v_diag, p, self._fflat, self._kmat, self._its,
-            self._stat, self._me, self._ce, self._dm, self._force, res,
-            self._dm_skip_output if output else self._dm_skip_none, self._carried, free,
+            self._stat, self._me, self._ce, self._force, res,
+            self._dm_skip_output if output else self._dm_skip_none, self._carried,
             self._kin if output else self._no_kin)
         if not ok:
             self._buffers_at = None
@@ -192,7 +189,6 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         self.h = self._hw.copy()
         self.X[:] = self._Xb
         self._buffers_at = None if output else (t, np.array(y[0::2], copy=True))
-        self._buffers_mats = not free  # M_e and ∂M_e/∂c are in the buffers
         if m.fluid is not None:  # water and air: M_a A - f (docs/theory.md §13)
             res[1::2] += m.fluid.evaluate(t, self._Xb, self._Vb, self._Ab)[0][self._fidx]
         if self.seabed is not None:  # the seabed's force on the nodes (docs/theory.md §17)
@@ -201,13 +197,13 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         return True
 
     def _conf_from_buffers(self):
-        """(state, M_e, C_e, ∂M_e/∂c) of the last successful ``evaluate`` (copies)."""
+        """(state, M_e, C_e, None) of the last successful ``evaluate`` (copies), without the
+        Lagrangian terms (their pass builds no matrices, and is not read here)."""
         state = ElementState(self.h, sym_from_upper(self._fflat), self._kmat.copy(),
                              self._its.copy(), self._stat.copy())
         me = self._me.copy() if self._want_m else (self._me if self._use_m else None)
         ce = self._ce.copy() if self._want_c else (self._ce if self._use_c else None)
-        dm = self._dm.copy() if self._want_dm else None
-        return state, me, ce, dm
+        return state, me, ce, None
 
     # ------------------------------------------------------------------ pieces
     def _supports(self, t: float):
@@ -229,7 +225,8 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         if self._cache_t == t and np.array_equal(self._cache_q, q):
             return self._cache
         at = self._buffers_at
-        if (at is not None and self._buffers_mats and at[0] == t
+        # the Lagrangian pass builds no matrices (§7.6): then the elements are solved again
+        if (at is not None and not self._want_dm and at[0] == t
                 and np.array_equal(at[1], q)):
             out = self._conf_from_buffers()
             self._cache_t, self._cache_q, self._cache = t, at[1], out

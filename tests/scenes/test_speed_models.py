@@ -88,24 +88,11 @@ def test_analytic_mass_gradient_matches_complex_step():
     """The forward-mode ∂M_e/∂c (fused into the element pass) equals the complex-step one
     (exact to round-off by construction: no difference is taken) on taut, sagging, near-vertical,
     inclined and loaded elements, with point masses inside."""
-    L0 = np.array([10.0, 10.0, 3.0, 20.0, 2.0, 12.0])
-    EA = np.array([1e8, 1e6, 1e5, 1e8, 1e4, 5e7])
-    w = np.array([100.0, 10.0, 50.0, 300.0, 5.0, 80.0])
-    chord = np.array([[10.0004, 0.0, 0.0], [6.0, 2.0, -5.0], [0.1, 0.2, -2.9],
-                      [15.0, 3.0, 8.0], [1.5, 1.0, 0.5], [8.0, -4.0, 6.0]])
-    loads = PointLoads.from_lists([[], [(3.0, [0.0, 0.0, 50.0])],
-                                   [(1.0, [5.0, 0.0, 20.0]), (2.0, [0.0, 3.0, 10.0])], [], [],
-                                   [(6.0, [0.0, 0.0, 900.0])]])
-    el = Elements(L0, EA, w, loads)
-    xi = np.array([0.5 - np.sqrt(0.15), 0.5, 0.5 + np.sqrt(0.15)])
-    gs = xi[None, :] * L0[:, None]
-    gw = np.tile(np.array([5.0, 8.0, 5.0]) / 18.0, (L0.size, 1))
-    m = np.array([10.0, 2.0, 1.0, 30.0, 3.0, 8.0])
-    pm = (np.array([0, 3, 5]), np.array([4.0, 11.0, 6.0]), np.array([7.0, 20.0, 15.0]))
+    el, chord, gs, gw, m, pm = _six_elements()
     state, me, _, dm = el.solve_dynamic(chord, None, gs, gw, m, None, pm, gradient=True)
     assert np.all(state.status == 0)
     ref = el.mass_gradient(state)
-    for e in range(L0.size):
+    for e in range(el.n):
         scale = np.abs(ref[e]).max()
         assert scale > 0
         np.testing.assert_allclose(dm[e], ref[e], rtol=0, atol=1e-9 * scale)
@@ -115,9 +102,8 @@ def test_analytic_mass_gradient_matches_complex_step():
 
 
 def _six_elements():
-    """The six elements of the test above (taut, sagging, near-vertical, inclined, loaded, with
-    point masses inside): (elements, chords, Gauss points and weights, mass per length, point
-    masses)."""
+    """Six elements (taut, sagging, near-vertical, inclined, loaded, with point masses inside):
+    (elements, chords, Gauss points and weights, mass per length, point masses)."""
     L0 = np.array([10.0, 10.0, 3.0, 20.0, 2.0, 12.0])
     EA = np.array([1e8, 1e6, 1e5, 1e8, 1e4, 5e7])
     w = np.array([100.0, 10.0, 50.0, 300.0, 5.0, 80.0])
