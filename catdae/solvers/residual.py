@@ -196,6 +196,23 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
                                             self._Vb.reshape(-1, 3)).ravel()[self._fidx]
         return True
 
+    # what the next evaluation starts from: the last pass's buffers and the carried Newton start
+    _START_BUFFERS = ("_hw", "_kmat", "_stat", "_its", "_fflat", "_Xb", "_carried", "X")
+
+    def start_state(self):
+        """Copies of what the next ``evaluate`` starts from (the tensions, the last pass's
+        buffers with its carried Newton start), for ``restore_start``: an IDA that goes on
+        after another ran from the same state (a lost order race) then evaluates exactly as if
+        the other had not run."""
+        return (None if self.h is None else self.h.copy(), self._buffers_at,
+                [getattr(self, name).copy() for name in self._START_BUFFERS])
+
+    def restore_start(self, saved) -> None:
+        h, self._buffers_at, arrays = saved
+        self.h = None if h is None else h.copy()
+        for name, a in zip(self._START_BUFFERS, arrays, strict=True):
+            getattr(self, name)[...] = a
+
     def _conf_from_buffers(self):
         """(state, M_e, C_e, None) of the last successful ``evaluate`` (copies), without the
         Lagrangian terms (their pass builds no matrices, and is not read here)."""

@@ -2,8 +2,9 @@
 
 The only module that imports sksundae. ``run_transient`` integrates one transient step: it
 builds the residual and iteration matrix (``residual.TransientProblem``), picks the linear
-solver, the tolerances and the BDF order cap, steps IDA one internal step at a time (stopping
-and restarting at the kinks and jumps of prescribed motions and loads), records the output times
+solver, the tolerances and the BDF order cap, calls IDA once per output time with the per-step
+work in its root function (``step_hook.StepHook``), stops and restarts at the kinks and jumps
+of prescribed motions and loads, records the output times
 (``record.OutputRecord``, arrays: datasets are made in ``catdae.output``) and keeps what was
 computed when a run fails or is interrupted. Its phases, in order: output times, IDA options
 (linear solver, tolerances, order), the consistent start, the integration loop, attributes.
@@ -15,6 +16,7 @@ second, racing again now and then (docs/theory.md §8.6).
 
 from __future__ import annotations
 
+import math
 import sys
 import time as _time
 import types
@@ -33,6 +35,7 @@ from catdae.solvers.order import (
 )
 from catdae.solvers.record import OutputRecord, note
 from catdae.solvers.residual import TransientProblem
+from catdae.solvers.step_hook import StepHook
 from catdae.solvers.tolerance import error_weights, resolve_mode
 
 
@@ -83,8 +86,8 @@ IDA = _import_ida()
 __all__ = ["IDA", "OrderChoice", "TransientProblem", "choose_solver", "run_transient"]
 
 INCREMENT_SECONDS = 20.0  # wall time between incremental writes of a long run
-STALL_STEP = 1e-12  # a step shorter than this (relative to t or the output interval) ...
-STALL_COUNT = 200  # ... this many times in a row stops the step as stuck
+IDA_ROOT_RETURN = 2  # IDASolve's flags: returned at a root of the root function (StepHook)
+IDA_TOO_MUCH_WORK = -1  # ... max_num_steps taken in one call
 
 
 def choose_solver(problem: TransientProblem, requested: str) -> str:
@@ -100,12 +103,6 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
     if band <= max(32, n2 // 4) and n2 <= 800:
         return "band"
     return "sparse"
-
-
-def _last(a: np.ndarray) -> np.ndarray:
-    """The last state of an IDA result's ``y`` or ``yp`` (1-D in one-step and single-time
-    calls; the last row where a version returns them as rows)."""
-    return a if a.ndim == 1 else a[-1]
 
 
 def output_times(t0: float, duration: float, dt_out: float) -> np.ndarray:
@@ -198,7 +195,8 @@ class _Run:
             # that is the intent (the analytic iteration matrix)
             warnings.filterwarnings("ignore", "Custom sparse Jacobian approximation",
                                     UserWarning)
-            return IDA(self.prob.resfn, **dict(self.options, max_order=max_order))
+            return IDA(self.prob.resfn, **dict(self.options, max_order=max_order),
+                       eventsfn=self.hook, num_events=1)
 
     # ------------------------------------------------------------------ attributes
     def attributes(self, n_valid: int) -> dict:
@@ -274,68 +272,85 @@ class _Run:
         return stops, befores, end_jump
 
     def _loop(self, writer, bar) -> None:
-        prob, times, t_end, record = self.prob, self.times, self.t_end, self.outputs.record
+        """IDA once per output time (or stop); the per-step work runs inside IDA, in the
+        root function ``StepHook`` (docs/theory.md §8.8), which also asks IDA to return at a
+        step's end where the order race changes the order cap or the step size collapsed."""
+        times, t_end = self.times, self.t_end
+        hook = self.hook = StepHook(self, bar)
         solver = self.make_solver(self.options["max_order"])
         solver.init_step(self.t0, self.y0, self.yp0)
-        record(0, self.t0, self.y0, self.yp0)
+        self.outputs.record(0, self.t0, self.y0, self.yp0)
         work = self.outputs.work  # the fluid's work, None without a fluid
         if work is not None:
             work.advance(self.t0, self.y0, self.yp0)
         self.k_done = 1
         t_int = self.t0
-        stalled = 0
         stops, befores, end_jump = self._stops()
         i_stop = 0
         last_write = _time.perf_counter()
+        first = True  # IDA's first step after a start is aimed at the stop (below)
         while self.k_done < times.size:
             t_stop = stops[i_stop]
-            res = solver.step(t_stop, method="onestep", tstop=t_stop)
+            tout = min(float(times[self.k_done]), t_stop)
+            if first:  # IDA sizes its first step from the distance to the time it is given:
+                hook.aim(math.nan, t_stop)  # one step towards the stop, as it always was
+                res = solver.step(t_stop, method="onestep", tstop=t_stop)
+            else:
+                hook.aim(tout, t_stop)
+                res = solver.step(tout, method="normal", tstop=t_stop)
+            t_new = float(res.t)
+            if res.status == IDA_ROOT_RETURN:  # the hook asked IDA to return at a step's end
+                solver, t_int, first = self._hook_stop(solver, res)
+                if solver is None:
+                    return
+                continue
+            if res.status == IDA_TOO_MUCH_WORK and t_new > t_int:  # max_num_steps in one call
+                t_int, first = t_new, False
+                continue
             if not res.success:
                 self.status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
                 return
-            t_new = res.t if type(res.t) is float else float(np.atleast_1d(res.t)[-1])
-            y_last, yp_last = _last(res.y), _last(res.yp)
-            # after an output interpolated inside the last step, IDA's next one-step call
-            # returns that step's end again without stepping: nothing new for the work
-            advanced = t_new > t_int
-            if advanced:
-                self.n_steps += 1
-                self.outputs.envelope.update(t_new, y_last)
-            # IDA's max_num_steps counts per call; in one-step mode guard the step size
-            # ourselves: steps that no longer advance time mean the integration is stuck
-            small = t_new - t_int <= STALL_STEP * max(abs(t_new), self.dt_out)
-            stalled = stalled + 1 if small else 0
             t_int = t_new
-            if stalled >= STALL_COUNT:
-                self.status = (f"step size collapsed at t = {t_int:.6g} s (IDA could not "
-                               f"advance; {prob.n_rejected} trial states rejected)")
-                return
-            at_stop = ((t_stop < t_end or end_jump)
-                       and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0))
-            self._record_passed(solver, t_int, y_last, yp_last, at_stop)
-            if work is not None and (advanced or at_stop):
-                work.advance(t_int, y_last, yp_last)
-            if at_stop:
+            if ((t_stop < t_end or end_jump)
+                    and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0)):
                 t_int = t_stop
                 i_stop += 1
-                self._restart(solver, t_stop, y_last, befores[i_stop - 1],
+                self._restart(solver, t_stop, res.y, befores[i_stop - 1],
                               more=i_stop < len(stops))
-            elif self.order_choice is not None and self.order_choice.measuring:
-                new_order = self.order_choice.observe(t_int)
-                if new_order is not None:
-                    solver, t_int = self._change_order(solver, new_order, t_int, y_last,
-                                                       yp_last)
+                hook.reset(t_stop)
+                first = True
+            elif not first:
+                self.outputs.record(self.k_done, t_int, res.y, res.yp)
+                self.k_done += 1
+            else:
+                first = False
             bar.update(t_int)
             if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
                 writer.write_increment(self.step.name, self.snapshot(self.k_done))
                 last_write = _time.perf_counter()
 
+    def _hook_stop(self, solver, res):
+        """IDA returned where the hook asked (a step's end): the order race changed the order
+        cap, or the step size collapsed (status set, solver None). Returns (the IDA to go on
+        with, its time, whether it is new: its first step is then aimed at the stop)."""
+        new_order = self.hook.take_order()
+        t = float(res.t)
+        if new_order is None:
+            self.status = (f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
+                           f"{self.prob.n_rejected} trial states rejected)")
+            return None, t, False
+        rollbacks = self.n_rollbacks
+        solver, t = self._change_order(solver, new_order, t, res.y, res.yp)
+        return solver, t, self.n_rollbacks == rollbacks
+
     def _change_order(self, solver, order: int, t_int: float, y_last, yp_last):
         """The BDF order cap changed (OrderChoice): (the IDA to go on with, its time). A race's
         trial order starts a new IDA, and the incumbent's is kept as it stands. Where the
         incumbent wins, its IDA goes on from the trial's start, its history intact: the
-        trial's outputs are recorded again and the fluid's work taken back to that time (the
-        envelope keeps the trial's steps, states of the same motion within the tolerance).
+        trial's outputs are recorded again, and the fluid's work and the residual's buffers
+        (its carried Newton start) taken back to that time, so that the incumbent goes on
+        exactly as if the trial had not run (the envelope keeps the trial's steps, states of
+        the same motion within the tolerance).
         A lost race so costs its trial window, not a new IDA's start at order 1 and the
         damping of what the trial order left in the state (docs/theory.md §8.6). Where the
         integrator was restarted during the trial (a stop), the incumbent starts anew."""
@@ -343,15 +358,19 @@ class _Run:
         work = self.outputs.work
         if self.order_choice.mode == "trial":
             self._kept = (solver, t_int, self.k_done, self.n_restarts,
-                          None if work is None else (work.t, work.W, work.P))
+                          None if work is None else (work.t, work.W, work.P),
+                          self.prob.start_state())
         elif kept is not None and kept[3] == self.n_restarts:
-            solver, t_int, self.k_done, _, saved = kept
+            solver, t_int, self.k_done, _, saved, start = kept
             if saved is not None:
                 work.t, work.W, work.P = saved
+            self.prob.restore_start(start)
             self.n_rollbacks += 1
+            self.hook.reset(t_int)
             return solver, t_int
         new = self.make_solver(order)
         new.init_step(t_int, y_last, yp_last)
+        self.hook.reset(t_int)
         return new, t_int
 
     def _restart(self, solver, t_stop: float, y_last, before, more: bool) -> None:
@@ -371,20 +390,4 @@ class _Run:
         while (self.k_done < times.size
                and abs(times[self.k_done] - t_stop) <= 1e-13 * max(abs(t_stop), 1.0)):
             self.outputs.record(self.k_done, times[self.k_done], y_last, yp_last)
-            self.k_done += 1
-
-    def _record_passed(self, solver, t_int, y_last, yp_last, at_stop) -> None:
-        """Record the output times that the last step passed (interpolated by IDA; one that
-        falls on a restart is recorded after it, with the velocities after the jump)."""
-        times = self.times
-        while self.k_done < times.size and times[self.k_done] <= t_int * (1 + 1e-13) + 1e-300:
-            tk = times[self.k_done]
-            if abs(tk - t_int) <= 1e-13 * max(abs(t_int), 1.0):
-                if at_stop:
-                    return
-                yk, ypk = y_last, yp_last
-            else:
-                ri = solver.step(tk, method="normal")
-                yk, ypk = _last(ri.y), _last(ri.yp)
-            self.outputs.record(self.k_done, tk, yk, ypk)
             self.k_done += 1

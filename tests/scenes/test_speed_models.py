@@ -275,18 +275,20 @@ def test_automatic_order_goes_to_order_2_where_it_is_cheaper():
 
 
 def test_a_lost_race_costs_its_trial_window_only():
-    """48 elements at rtol 3e-4 over 5 s: the run starts at order 2, races order 5 once (at
-    about 0.9 s) and order 2 wins. The incumbent's IDA goes on from the trial's start with its
-    history intact, so the run is fixed order 2's run, recorded again over the trial's span:
-    the midspan history equals fixed order 2's to round-off (measured 1.4e-9 m; asserted
-    below a thousandth of the 1.1 mm error both have against a tight run), and the race
+    """48 elements at rtol 3e-4 over 6 s: the run starts at order 2, races order 5 once (at
+    about 1.6 s) and order 2 wins (over 5 s the race is left out: too few steps to go). The
+    incumbent's IDA goes on from the trial's start with its history intact, so the run is
+    fixed order 2's run, recorded again over the trial's span: the midspan history equals
+    fixed order 2's to round-off (measured identical: the residual's buffers, its carried
+    Newton start, are taken back with the incumbent; asserted below 1e-9 m, against the
+    1.1 mm error both have against a tight run), and the race
     costs at most the trial's window of steps (a new IDA from the trial's end took about 400
     more on this cable: it starts at order 1 and first damps what order 5 left)."""
     from catdae.solvers.order import OrderChoice
 
     runs = {}
     for key, rtol, order in (("auto", 3e-4, None), ("two", 3e-4, 2), ("tight", 1e-6, 2)):
-        ds = catdae.run(catdae.load_case(_moving_cable(48, 5.0, rtol, order)),
+        ds = catdae.run(catdae.load_case(_moving_cable(48, 6.0, rtol, order)),
                         progress=False)["motion"].ds
         runs[key] = (ds.position.sel(node="c.24", axis="z").values, int(ds.attrs["n_steps"]),
                      str(ds.attrs["order_choice"]))
@@ -294,18 +296,19 @@ def test_a_lost_race_costs_its_trial_window_only():
     assert "1 lost race(s) taken back" in choice, choice
     err = np.abs(z2 - zt).max()
     assert err > 1e-4  # the tolerance's own error, for scale
-    assert np.abs(za - z2).max() < 1e-3 * err, np.abs(za - z2).max()
+    assert np.abs(za - z2).max() < 1e-9, np.abs(za - z2).max()
     assert n2 < na <= n2 + OrderChoice.WINDOW, (na, n2, choice)
 
 
 def test_a_lost_race_takes_the_fluids_work_back():
-    """The same cable 50 m under still water (d 5 cm, Cd 1.2, Ca 1): the race is lost at
-    about 1.4 s and the incumbent goes on from the trial's start; the work the water did,
-    accumulated step by step, is taken back to that time with it, so it equals fixed order
-    2's to round-off (without that it counted the trial's span twice: 0.58 J of 207 J)."""
+    """The same cable 50 m under still water (d 5 cm, Cd 1.2, Ca 1), 8 s: the race is lost at
+    about 1.9 s and the incumbent goes on from the trial's start (1.4 s); the work the water
+    did, accumulated step by step, is taken back to that time with it, so it equals fixed
+    order 2's to round-off (without that it counted the trial's span twice: 0.58 J of 207 J;
+    measured identical, the residual's carried Newton start being taken back too)."""
     runs = {}
     for order in (None, 2):
-        text = _moving_cable(48, 5.0, 3e-4, order).replace(
+        text = _moving_cable(48, 8.0, 3e-4, order).replace(
             "weight = 100.0\n",
             "weight = 100.0\ndiameter = 0.05\ndrag_normal = 1.2\nadded_mass_normal = 1.0\n", 1)
         text += "\n[water]\ndensity = 1000.0\nsurface = 50.0\ndepth = 200.0\n"

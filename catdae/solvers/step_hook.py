@@ -1,0 +1,83 @@
+"""What a transient does after each of IDA's steps, run from inside IDA (docs/theory.md §8.8).
+
+IDA is called once per output time (its "normal" mode: it steps past the output and
+interpolates back). What must see every accepted step (the tension envelope, the fluid's work,
+the step count, the order race, a stalled step size, the progress report) is done by
+``StepHook``, which IDA calls as its root function: with root finding on, IDA evaluates the
+root function at the end of every step it takes, in time order, and at each output time it
+interpolates to. The function never has a root unless the hook asks IDA to stop (the order
+race chose a new order cap, or the step size collapsed): it then changes sign at that step's
+end, IDA locates the root there and returns at it, and the driver acts. Calling IDA once per
+step instead (its "one-step" mode) costs a round trip through scikit-sundae's Python wrapper
+per step (a result object, copies of the state, statistics), about as much as IDA's own work
+on a small mesh.
+"""
+
+from __future__ import annotations
+
+import math
+
+STALL_STEP = 1e-12  # a step shorter than this (relative to t or the output interval) ...
+STALL_COUNT = 200  # ... this many times in a row stops the step as stuck
+
+
+class StepHook:
+    """IDA's root function (one component): the per-step work of a transient ``run``
+    (catdae.solvers.transient), and a sign change at a step's end where the driver must act.
+
+    ``aim(tout, tstop)`` before each IDA call says which time is an output (evaluated by IDA
+    without a step ending there, unless it is also the stop time, where IDA ends a step
+    exactly). Evaluations at or before the latest time seen are IDA locating a root (or the
+    check at a restart): they only answer the sign."""
+
+    def __init__(self, run, bar):
+        self.run = run
+        self.bar = bar
+        self.work = run.outputs.work
+        self.envelope = run.outputs.envelope
+        self.race = run.order_choice if (run.order_choice is not None
+                                         and run.order_choice.measuring) else None
+        self.dt_out = run.dt_out
+        self.tout = self.tstop = math.nan
+        self.reset(run.t0)
+
+    def reset(self, t: float) -> None:
+        """IDA starts (again) from time t: nothing asked of it, nothing seen after t."""
+        self.t_seen = self.t_prev = t
+        self.t_flag = None  # the step end at which IDA is asked to return
+        self.new_order = None  # the order cap the race chose there
+        self.stalled = 0
+        self.stuck = False
+
+    def aim(self, tout: float, tstop: float) -> None:
+        self.tout, self.tstop = tout, tstop
+
+    def take_order(self) -> int | None:
+        """The order cap asked for at the flagged step (None: a stall), and the flag cleared."""
+        new, self.new_order, self.t_flag = self.new_order, None, None
+        return new
+
+    def __call__(self, t, y, yp, events):
+        if t > self.t_seen and self.t_flag is None:
+            self.t_seen = t
+            if t != self.tout or t == self.tstop:  # the end of an accepted step
+                self._step(t, y, yp)
+        events[0] = -1.0 if self.t_flag is not None and t >= self.t_flag else 1.0
+
+    def _step(self, t: float, y, yp) -> None:
+        run = self.run
+        run.n_steps += 1
+        self.envelope.update(t, y)
+        if self.work is not None:
+            self.work.advance(t, y, yp)
+        small = t - self.t_prev <= STALL_STEP * max(abs(t), self.dt_out)
+        self.stalled = self.stalled + 1 if small else 0
+        self.t_prev = t
+        if self.stalled >= STALL_COUNT:
+            self.stuck = True
+            self.t_flag = t
+        elif self.race is not None and t != self.tstop:  # a stop restarts IDA anyway
+            new = self.race.observe(t)
+            if new is not None:
+                self.new_order, self.t_flag = new, t
+        self.bar.update(t)
