@@ -115,10 +115,24 @@ def pendulum(segments=10, zeta=0.01, cfl=0.1, periods=5.0) -> dict:
     return _run(text, go)
 
 
-def violent(segments=50, duration=4.0, cfl=0.5, dt_c=1e-4) -> dict:
+def _end_a(t, w):
+    """End A's position and velocity at t: y = 3 (1 - cos wt), z = 3 sin wt."""
+    return ([0.0, 3 * (1 - math.cos(w * t)), 3 * math.sin(w * t)],
+            [0.0, 3 * w * math.sin(w * t), 3 * w * math.cos(w * t)])
+
+
+def violent(segments=50, duration=4.0, cfl=0.5, dt_c=1e-4, exact=False) -> dict:
     """The violent example 2 (span 10 m, 15 m of wire, EA 3.4e7, 5 kg/m, in air: water
     density 1e-9), end A coupled and moved as a = 3 m: y = a (1 - cos πt), z = a sin πt. The
-    peak of MoorDyn's largest segment tension, read after every coupling step ``dt_c``."""
+    peak of MoorDyn's largest node tension (GetLineMaxTen), read after every coupling step ``dt_c``.
+
+    MoorDyn takes a coupled point's position at the start of the step and moves it on from there
+    at the velocity it is given (Point::updateFairlead: r = x + v τ, 0 <= τ <= dt_c); by default
+    the driver hands it the end-of-step position and velocity, so the point leads by one coupling
+    step (its first step jumps 3π dt_c m). ``exact``: the start-of-step position and the chord
+    velocity to the next one, so that the point passes through every exact position; and the peak
+    read over nodes 0..N: GetLineMaxTen stops at node N - 1 (the average of the two last segments'
+    tensions), GetLineFairTen is node N, the last segment at end B, where the peak is."""
     text = _input(
         "violent example 2", "wire 0.0113 5.0 3.4E7 0.0 0 0.0 0.0 0.0 0.0",
         "1 Coupled 0 0 0 0 0 0 0\n2 Fixed 10 0 0 0 0 0 0",
@@ -136,12 +150,16 @@ def violent(segments=50, duration=4.0, cfl=0.5, dt_c=1e-4) -> dict:
         w = math.pi
         for k in range(int(round(duration / dt_c))):
             te = (k + 1) * dt_c
-            x = [0.0, 3 * (1 - math.cos(w * te)), 3 * math.sin(w * te)]
-            v = [0.0, 3 * w * math.sin(w * te), 3 * w * math.cos(w * te)]
+            x, v = _end_a(te, w)
+            if exact:
+                x0 = _end_a(k * dt_c, w)[0]
+                x, v = x0, [(b - a) / dt_c for a, b in zip(x0, x, strict=True)]
             c1 = time.process_time()
             moordyn.Step(s, x, v, k * dt_c, dt_c)
             c_steps += time.process_time() - c1
             tension = moordyn.GetLineMaxTen(line)
+            if exact:
+                tension = max(tension, moordyn.GetLineFairTen(line))
             if tension > peak:
                 peak, t_peak = tension, te
         moordyn.Close(s)
