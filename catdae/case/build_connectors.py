@@ -12,11 +12,11 @@ import math
 from dataclasses import dataclass
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
 from catdae.case.messages import unknown_word
+from catdae.case.schema import STRICT
 
-_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 _Pos = Annotated[float, Field(gt=0)]
 _NonNeg = Annotated[float, Field(ge=0)]
 _Name = Annotated[str, Field(min_length=1)]
@@ -27,7 +27,7 @@ COINCIDENT_TOL = 1e-9  # m: connector ends closer than this coincide
 
 
 class _Spring(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     name: _Name
     ends: _Ends
     stiffness: _Pos  # N/m
@@ -35,14 +35,14 @@ class _Spring(BaseModel):
 
 
 class _Damper(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     name: _Name
     ends: _Ends
     coefficient: _NonNeg  # N s/m
 
 
 class _Bar(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     name: _Name
     ends: _Ends
     EA: _Pos  # N

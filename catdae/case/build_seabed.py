@@ -9,22 +9,21 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
 from catdae.case.messages import found_text, is_number
 from catdae.case.model import Seabed
-
-_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+from catdae.case.schema import STRICT
 
 
 class _Friction(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     axial: Annotated[float, Field(ge=0)]
     lateral: Annotated[float, Field(ge=0)]
 
 
 class _Seabed(BaseModel):
-    model_config = _STRICT
+    model_config = STRICT
     z: float | None = None
     stiffness: Annotated[float, Field(gt=0)] | None = None
     damping: Annotated[float, Field(ge=0)] = 0.0
