@@ -315,9 +315,19 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
     def observe(self, t: float, y: np.ndarray, yp: np.ndarray):
         """Positions, velocities, accelerations, tensions, reactions and energies at t (one
         compiled residual pass leaves the element state and forces in the buffers)."""
-        m = self.model
         # read-only views, as IDA passes them: one compiled signature of the pass, not two
         y, yp = _readonly(y), _readonly(yp)
+        # the step's own buffers are put back after: the tension envelope carries the end
+        # forces of the step's end from them (§18.3), and IDA evaluates it there after an
+        # output inside the step (§8.8); without them it solved every element afresh
+        saved = self.start_state()
+        try:
+            return self._observe(t, y, yp)
+        finally:
+            self.restore_start(saved)
+
+    def _observe(self, t: float, y: np.ndarray, yp: np.ndarray):
+        m = self.model
         if not self.evaluate(t, y, yp, self._res_scratch, output=True):
             raise SolverError(f"output at t = {t:.6g} s: an element cannot be solved",
                               termination="element failure")
