@@ -299,7 +299,10 @@ def test_support_motion_is_followed_exactly_and_its_work_is_the_energy_gain(mass
 
 
 def test_mass_proportional_rayleigh_damping_decays_at_alpha_over_two():
-    # C = alpha M damps every mode at exp(-alpha t / 2); equal to material damping c = alpha m
+    # C = alpha M damps every mode at exp(-alpha t / 2); equal to material damping c = alpha m.
+    # The two are the same equations, compared at rtol 1e-10 (measured 2.5e-13 of the amplitude
+    # apart): at rtol 1e-8 each run's own error, 2.6e-7 of it, exceeds the 1e-7 compared, and
+    # whether the two happen to agree depends on round-off choosing the same steps
     extra = load("P", [0.0, 5.0, 0.0], node="c.4")
     ys = {}
     for key, damping, material in (
@@ -307,7 +310,7 @@ def test_mass_proportional_rayleigh_damping_decays_at_alpha_over_two():
             ("rayleigh", {"kind": "rayleigh", "alpha": 0.8, "beta": 0.0}, None),
             ("material", {"kind": "material"}, {"damping": 1.6})):
         steps = static_step() + step("transient", "tr", remove=["P"], duration=0.8,
-                                     output_interval=0.002, rtol=1e-8, atol=1e-11,
+                                     output_interval=0.002, rtol=1e-10, atol=1e-13,
                                      damping=damping)
         case = single_span((10.05, 0.0, 0.0), 10.0, 1.0e6, 2.0, 8, extra, steps, gravity=0.0,
                            properties=material)
