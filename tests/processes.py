@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import subprocess
 import sys
 import threading
@@ -14,6 +15,14 @@ import time
 from pathlib import Path
 
 from scene_toml import long_transient
+
+
+def default_signals() -> None:
+    """In a child before it runs: the signals the tests send at their default disposition. A
+    runner started under ``nohup`` ignores SIGHUP, its children inherit that, and catdae keeps
+    an ignored signal ignored (catdae.interrupts): the run would not stop."""
+    for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(s, signal.SIG_DFL)
 
 
 def catdae_process(args, cwd, *, snapshot_seconds=None):
@@ -26,7 +35,8 @@ def catdae_process(args, cwd, *, snapshot_seconds=None):
                 f"t.INCREMENT_SECONDS = {snapshot_seconds!r}; sys.exit(c.main(sys.argv[1:]))")
         cmd = [sys.executable, "-c", code, *args]
     return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, cwd=cwd,
-                            env=dict(os.environ, PYTHONUNBUFFERED="1"))
+                            env=dict(os.environ, PYTHONUNBUFFERED="1"),
+                            preexec_fn=default_signals)
 
 
 def long_case(path: Path, duration: float = 1000.0) -> Path:

@@ -29,7 +29,7 @@ import catdae
 import catdae.output.results
 from catdae.cli import main
 
-from processes import interrupted_run, long_case
+from processes import default_signals, interrupted_run, long_case
 from scene_toml import (
     cable_scene,
     load,
@@ -504,7 +504,7 @@ def test_a_signalled_study_keeps_its_runs_and_writes_a_marked_partial_report(tmp
          "1e-6", "--reference", "rtol=1e-5", "--scheduler", "synchronous", "--duration", "100",
          "--store", str(store), "-o", str(out), "--no-plots"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path,
-        env=dict(os.environ, PYTHONUNBUFFERED="1"))
+        env=dict(os.environ, PYTHONUNBUFFERED="1"), preexec_fn=default_signals)
     lines: list[bytes] = []
 
     def read_out():
@@ -564,14 +564,19 @@ def test_plot_and_export_stop_alike_on_a_signal(three_kinds, tmp_path, monkeypat
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", save_then_hang_up)
     monkeypatch.setattr(meshio, "write", write_then_hang_up)
     figs, vtk = tmp_path / "figs", tmp_path / "vtk"
-    for args, folder in ((["plot", three_kinds, "-o", figs], figs),
-                         (["export", three_kinds, "--vtk", vtk], vtk)):
-        code, out, err = in_process(args, capsys)
-        assert code == 129, err
-        assert err == "catdae: interrupted by SIGHUP\n"
-        written = sorted(p for p in folder.rglob("*") if p.is_file())
-        assert len(written) == 1 and written[0].stat().st_size > 1000, written
-    assert signal.getsignal(signal.SIGHUP) == signal.SIG_DFL  # the policy ends with the command
+    # a runner under nohup ignores SIGHUP, and catdae keeps an ignored signal ignored
+    previous = signal.signal(signal.SIGHUP, signal.SIG_DFL)
+    try:
+        for args, folder in ((["plot", three_kinds, "-o", figs], figs),
+                             (["export", three_kinds, "--vtk", vtk], vtk)):
+            code, out, err = in_process(args, capsys)
+            assert code == 129, err
+            assert err == "catdae: interrupted by SIGHUP\n"
+            written = sorted(p for p in folder.rglob("*") if p.is_file())
+            assert len(written) == 1 and written[0].stat().st_size > 1000, written
+        assert signal.getsignal(signal.SIGHUP) == signal.SIG_DFL  # the policy ends with it
+    finally:
+        signal.signal(signal.SIGHUP, previous)
 
 
 def test_a_signal_before_the_first_output_of_a_transient_keeps_the_run(tmp_path, monkeypatch,
