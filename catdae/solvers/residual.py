@@ -204,14 +204,18 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         buffers with its carried Newton start), for ``restore_start``: an IDA that goes on
         after another ran from the same state (a lost order race) then evaluates exactly as if
         the other had not run."""
-        return (None if self.h is None else self.h.copy(), self._buffers_at,
-                [getattr(self, name).copy() for name in self._START_BUFFERS])
+        arrays = [getattr(self, name).copy() for name in self._START_BUFFERS]
+        if self.axial is not None:  # its chord rates, which the envelope's carry reads too
+            arrays += [self.axial.g.copy(), self.axial.edot.copy()]
+        return (None if self.h is None else self.h.copy(), self._buffers_at, arrays)
 
     def restore_start(self, saved) -> None:
         h, self._buffers_at, arrays = saved
         self.h = None if h is None else h.copy()
-        for name, a in zip(self._START_BUFFERS, arrays, strict=True):
+        for name, a in zip(self._START_BUFFERS, arrays, strict=False):
             getattr(self, name)[...] = a
+        if self.axial is not None:
+            self.axial.g[...], self.axial.edot[...] = arrays[-2:]
 
     def _conf_from_buffers(self):
         """(state, M_e, C_e, None) of the last successful ``evaluate`` (copies), without the

@@ -30,12 +30,12 @@ DAMPING = {
 }
 
 
-def problem(mass_model: str, damping: str) -> TransientProblem:
+def problem(mass_model: str, damping: str, step_extra: str = "") -> TransientProblem:
     text = cable_scene(
         B=(12.0, 2.0, 3.0), L0=13.0, EA=1.0e5, mass=2.0, elements=4, gauss_points=3,
         extra=point_mass("pm", 6.0, cable="c", s=4.1),
         steps=static_step() + transient_step("dyn", 1.0, 0.1, rtol=1e-8, atol=1e-10,
-                                             extra=DAMPING[damping]))
+                                             extra=DAMPING[damping] + step_extra))
     text = text.replace("mass = 2.0\n", "mass = 2.0\ndamping = 3.0\n", 1)  # c per metre
     case = catdae.load_case(text)
     mesh = build_mesh(case)
@@ -136,3 +136,29 @@ def test_velocity_columns_of_the_iteration_matrix_while_moving(mass_model, dampi
     n = prob.n
     np.testing.assert_array_equal(J[0::2, 0::2], CJ * np.eye(n))
     np.testing.assert_array_equal(J[0::2, 1::2], -np.eye(n))
+
+
+@pytest.mark.parametrize("axial", [False, True], ids=["plain", "axial_damping"])
+def test_an_output_leaves_the_residual_as_it_was(axial):
+    """An output between two residual evaluations (IDA's normal mode interpolates one inside a
+    step, docs/theory.md §8.8) puts the residual's buffers back: the state the next residual
+    starts from (its carried Newton start, and with axial damping the chord rates the tension
+    envelope carries with) is bit for bit what it was, and so is the next residual, against
+    the same sequence without the output."""
+    runs = []
+    for with_output in (False, True):
+        prob = problem("blended", "material",
+                       "\naxial_damping = { ratio = 0.05 }" if axial else "")
+        assert (prob.axial is not None) == axial
+        y, yp = state(prob, moving=True)
+        residual(prob, T, y, yp)
+        before = prob.start_state()
+        if with_output:
+            prob.observe(T + 0.01, y + 1e-3, yp)
+            after = prob.start_state()
+            assert after[1] is before[1]  # the same (t, q) the buffers hold
+            for a, b in zip(before[2], after[2], strict=True):
+                np.testing.assert_array_equal(a, b)
+            np.testing.assert_array_equal(before[0], after[0])
+        runs.append(residual(prob, T + 0.002, y + 1e-4, yp))
+    np.testing.assert_array_equal(runs[0], runs[1])
