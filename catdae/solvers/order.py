@@ -62,7 +62,8 @@ class OrderChoice:
         self.t_mark = None
         self.incumbent = self.order
         self.interval = self.FIRST_INTERVAL
-        self.rate = {}  # latest steps per simulated second measured at each order
+        self.rate = {}  # steps per simulated second at each order, as the race uses them
+        self.measured = {}  # the latest measurement at each order
         self.races = []  # (t, steps/s at 5, steps/s at 2, chosen)
         self.skipped = 0  # races not run because order 5 cannot win
         self.short = 0  # races not run because too little of the step was left
@@ -91,6 +92,15 @@ class OrderChoice:
         return not (2 in self.rate
                     and self.MARGIN * self.rate[2] <= self.omega_max / self.STABILITY_HW)
 
+    def _measure(self, measured: float) -> None:
+        """The rate of the current order: the incumbent's is the lower of its last two
+        measurements, so that a burst of short steps within one window (content either order
+        must resolve) neither starts a race nor decides one."""
+        previous = self.measured.get(self.order)
+        self.measured[self.order] = measured
+        self.rate[self.order] = (min(measured, previous) if self.mode == "run"
+                                 and previous is not None else measured)
+
     def observe(self, t: float) -> int | None:
         """Called after every step at time t; returns the new order cap when it changes."""
         self.count += 1
@@ -110,7 +120,7 @@ class OrderChoice:
             self.count = self.length - half - 1  # order 2 is still damping what the start
             self.t_mark = None  # excited: measure a later half-window
             return None
-        self.rate[self.order] = half / (t - self.t_mark)
+        self._measure(half / (t - self.t_mark))
         self.count = 0
         self.t_mark = None
         other = 7 - self.order
