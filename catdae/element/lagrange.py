@@ -40,6 +40,19 @@ def _sym9(f0, f1, f2, f3, f4, f5):
 
 
 @njit(cache=True, inline="always")
+def _mat9(kk):
+    """A 3x3 array as a 9-tuple."""
+    return (kk[0, 0], kk[0, 1], kk[0, 2], kk[1, 0], kk[1, 1], kk[1, 2], kk[2, 0], kk[2, 1],
+            kk[2, 2])
+
+
+@njit(cache=True, inline="always")
+def _dsym9(fg, m):
+    """∂G/∂h_m (or ∂F/∂h_m) as a 9-tuple, from column m of ``partial_grad``'s fg (6, 3)."""
+    return _sym9(fg[0, m], fg[1, m], fg[2, m], fg[3, m], fg[4, m], fg[5, m])
+
+
+@njit(cache=True, inline="always")
 def _comb(a, x, b, y, c, z):
     """a x + b y + c z for 3-tuples x, y, z."""
     return (a * x[0] + b * y[0] + c * z[0], a * x[1] + b * y[1] + c * z[1],
@@ -87,12 +100,9 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
     """
     if not partial_grad(he[0], he[1], he[2], w, ea, l0, ls, lf, k0, k1, f6, fg):
         return False, 0.0
-    K = (kk[0, 0], kk[0, 1], kk[0, 2], kk[1, 0], kk[1, 1], kk[1, 2], kk[2, 0], kk[2, 1],
-         kk[2, 2])
+    K = _mat9(kk)
     # ∂F/∂h_m and ∂K/∂c_k = -K ∂F_k K, ∂F_k = Σ_m ∂F/∂h_m K[m, k]
-    F0 = _sym9(fg[0, 0], fg[1, 0], fg[2, 0], fg[3, 0], fg[4, 0], fg[5, 0])
-    F1 = _sym9(fg[0, 1], fg[1, 1], fg[2, 1], fg[3, 1], fg[4, 1], fg[5, 1])
-    F2 = _sym9(fg[0, 2], fg[1, 2], fg[2, 2], fg[3, 2], fg[4, 2], fg[5, 2])
+    F0, F1, F2 = _dsym9(fg, 0), _dsym9(fg, 1), _dsym9(fg, 2)
     dK0 = _mm(K, _mm(_comb9(-K[0], F0, -K[3], F1, -K[6], F2), K))
     dK1 = _mm(K, _mm(_comb9(-K[1], F0, -K[4], F1, -K[7], F2), K))
     dK2 = _mm(K, _mm(_comb9(-K[2], F0, -K[5], F1, -K[8], F2), K))
@@ -127,9 +137,7 @@ def lagrange_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm
                acc[5] + wq * btn[2])
         if fade == 0.0:
             continue
-        G0 = _sym9(fg[0, 0], fg[1, 0], fg[2, 0], fg[3, 0], fg[4, 0], fg[5, 0])
-        G1 = _sym9(fg[0, 1], fg[1, 1], fg[2, 1], fg[3, 1], fg[4, 1], fg[5, 1])
-        G2 = _sym9(fg[0, 2], fg[1, 2], fg[2, 2], fg[3, 2], fg[4, 2], fg[5, 2])
+        G0, G1, G2 = _dsym9(fg, 0), _dsym9(fg, 1), _dsym9(fg, 2)
         p0 = _mv(G0, kdv)
         p1 = _mv(G1, kdv)
         p2 = _mv(G2, kdv)
@@ -178,10 +186,8 @@ def kinetic_one(he, kk, l0, ea, w, ls, lf, k0, k1, gs_e, gw_e, scale_e, pm0, pm1
     """share ½ veᵀ M_e ve = share ½ Σ_q W_q |v_i + B_q Δv|² of a solved taut element, without
     M_e (an output's kinetic energy, where the element's forces are not read); NaN where a
     flexibility cannot be evaluated. Work arrays: d3 (3,), f6 (6,)."""
-    K = (kk[0, 0], kk[0, 1], kk[0, 2], kk[1, 0], kk[1, 1], kk[1, 2], kk[2, 0], kk[2, 1],
-         kk[2, 2])
     dv = (ve[3] - ve[0], ve[4] - ve[1], ve[5] - ve[2])
-    kdv = _mv(K, dv)
+    kdv = _mv(_mat9(kk), dv)
     kin = 0.0
     nq = gs_e.shape[0]
     for q in range(nq + pm1 - pm0):

@@ -4,10 +4,10 @@ IDA calls the residual thousands of times per simulated second. Done as separate
 (scatter the unknowns, chords, element solve, mass, forces, gather) it spent as much time in
 Python between the compiled kernels as in them on meshes of tens of elements
 (benchmarks/speed_accuracy.md §7). ``residual_pass`` does all of it in one call and leaves the
-element state (tensions, flexibilities, stiffnesses; the masses and ∂M/∂c where asked for) in
-the caller's buffers, where the iteration matrix, the envelope and the outputs find it. The
-passes IDA calls take the Lagrangian elements' inertia forces without their matrices
-(``free``, docs/theory.md §7.6).
+element state (tensions, flexibilities, stiffnesses; the masses where asked for) in
+the caller's buffers, where the iteration matrix, the envelope and the outputs find it. With
+the Lagrangian terms the taut elements' inertia forces are taken without their matrices
+(``lagrange.lagrange_one``, docs/theory.md §7.6).
 
 The element work is written out here rather than through ``mass.dynamics_one``: a call
 between compiled functions with some forty array arguments cost about 0.6 µs per element
@@ -34,7 +34,8 @@ CARRY = 0.25  # largest carried change of an element's end force, relative to it
 def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, w, ptr, ls, lf,
                   load_total, wl0, h, hw, use_h, tol, max_iter, gs, gw, mq, cq, pmptr, pms, pmm,
                   want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
-                  p_nodal, fflat, kmat, its, stat, me, ce, force, res, dm_skip, carried, kin):
+                  p_nodal, fflat, kmat, its, stat, me, ce, force, res, energy_only, carried,
+                  kin):
     """r_q = q' - v and r_v = M v' + C v + g + F - P on the free dofs, into ``res`` (2n,).
 
     y = [q, v] and yp interleaved per unknown; unknown k is full dof ``fidx[k]``; the fixed
@@ -47,7 +48,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
 
     ``want_dm`` (the Lagrangian velocity terms): the taut elements' M a and velocity terms go
     straight into the forces (``lagrange_one``, docs/theory.md §7.6) and their ``me`` is not
-    built (left as it was); the iteration matrix builds the matrices itself. ``dm_skip``
+    built (left as it was); the iteration matrix builds the matrices itself. ``energy_only``
     (n_elements,): elements that get no inertia force at all, only their kinetic energy (an
     output's pass, whose forces are read at the supports only, marks those that touch no
     supported dof; every residual IDA sees has none marked). ``kin`` (n_elements, or empty):
@@ -117,7 +118,7 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
                     for a in range(6):
                         ve6[a] = V[edofs[e, a]]
                         ae6[a] = A[edofs[e, a]] + alpha * V[edofs[e, a]]
-                    if dm_skip[e]:  # an output's element off the supports: its energy alone
+                    if energy_only[e]:  # an output's element off the supports: its energy alone
                         ke = kinetic_one(hw[e], kmat[e], l0[e], ea[e], w[e], ls, lf, k0, k1,
                                          gs[e], gw[e], mq[e], pmptr[e], pmptr[e + 1], pms, pmm,
                                          scale, ve6, xw, g6)

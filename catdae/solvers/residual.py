@@ -125,9 +125,9 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
                     np.zeros((ne, 6, 6)) if consistent else self._dummy3)
         self._ce = (m.linear_element_mass(damping=True) if mm.linear and self.material else
                     np.zeros((ne, 6, 6)) if self._want_c else self._dummy3)
-        self._dm_skip_none = np.zeros(ne, np.bool_)
+        self._energy_only_none = np.zeros(ne, np.bool_)
         # an output reads the forces at the supports only (reactions)
-        self._dm_skip_output = ~np.isin(m.edofs, m.fixed).any(axis=1)
+        self._energy_only_output = ~np.isin(m.edofs, m.fixed).any(axis=1)
         self._fflat = np.zeros((ne, 6))
         self._kmat = np.zeros((ne, 3, 3))
         self._its = np.zeros(ne, np.int64)
@@ -177,7 +177,7 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
             self._use_m, self._want_c, self._use_c, self._want_dm, self._scale, self.alpha,
             self.beta, self.m_diag, self._v_diag, p, self._fflat, self._kmat, self._its,
             self._stat, self._me, self._ce, self._force, res,
-            self._dm_skip_output if output else self._dm_skip_none, self._carried,
+            self._energy_only_output if output else self._energy_only_none, self._carried,
             self._kin if output else self._no_kin)
         if not ok:
             self._buffers_at = None
@@ -205,17 +205,17 @@ class TransientProblem(ConsistentStart, ConnectorTerms, IterationMatrix):
         after another ran from the same state (a lost order race) then evaluates exactly as if
         the other had not run."""
         arrays = [getattr(self, name).copy() for name in self._START_BUFFERS]
-        if self.axial is not None:  # its chord rates, which the envelope's carry reads too
-            arrays += [self.axial.g.copy(), self.axial.edot.copy()]
-        return (None if self.h is None else self.h.copy(), self._buffers_at, arrays)
+        # the axial damping's chord rates, which the envelope's carry reads too
+        rates = None if self.axial is None else (self.axial.g.copy(), self.axial.edot.copy())
+        return (None if self.h is None else self.h.copy(), self._buffers_at, arrays, rates)
 
     def restore_start(self, saved) -> None:
-        h, self._buffers_at, arrays = saved
+        h, self._buffers_at, arrays, rates = saved
         self.h = None if h is None else h.copy()
-        for name, a in zip(self._START_BUFFERS, arrays, strict=False):
+        for name, a in zip(self._START_BUFFERS, arrays, strict=True):
             getattr(self, name)[...] = a
-        if self.axial is not None:
-            self.axial.g[...], self.axial.edot[...] = arrays[-2:]
+        if rates is not None:
+            self.axial.g[...], self.axial.edot[...] = rates
 
     def _conf_from_buffers(self):
         """(state, M_e, C_e, None) of the last successful ``evaluate`` (copies), without the

@@ -339,21 +339,21 @@ class _Run:
             self.status = (f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
                            f"{self.prob.n_rejected} trial states rejected)")
             return None, t, False
-        rollbacks = self.n_rollbacks
-        solver, t = self._change_order(solver, new_order, t, res.y, res.yp)
-        return solver, t, self.n_rollbacks == rollbacks
+        solver, t, fresh = self._change_order(solver, new_order, t, res.y, res.yp)
+        self.hook.reset(t)  # IDA goes on from t: nothing asked of it, nothing seen after t
+        return solver, t, fresh
 
     def _change_order(self, solver, order: int, t_int: float, y_last, yp_last):
-        """The BDF order cap changed (OrderChoice): (the IDA to go on with, its time). A race's
-        trial order starts a new IDA, and the incumbent's is kept as it stands. Where the
-        incumbent wins, its IDA goes on from the trial's start, its history intact: the
-        trial's outputs are recorded again, and the fluid's work and the residual's buffers
-        (its carried Newton start) taken back to that time, so that the incumbent goes on
-        exactly as if the trial had not run (the envelope keeps the trial's steps, states of
-        the same motion within the tolerance).
-        A lost race so costs its trial window, not a new IDA's start at order 1 and the
-        damping of what the trial order left in the state (docs/theory.md §8.6). Where the
-        integrator was restarted during the trial (a stop), the incumbent starts anew."""
+        """The BDF order cap changed (OrderChoice): (the IDA to go on with, its time, whether it
+        is a new IDA). A race's trial order starts a new IDA, and the incumbent's is kept as it
+        stands. Where the incumbent wins, its IDA goes on from the trial's start, its history
+        intact: the trial's outputs are recorded again, and the fluid's work and the residual's
+        buffers (its carried Newton start) taken back to that time, so that the incumbent goes
+        on exactly as if the trial had not run (the envelope keeps the trial's steps, states of
+        the same motion within the tolerance). A lost race so costs its trial window, not a new
+        IDA's start at order 1 and the damping of what the trial order left in the state
+        (docs/theory.md §8.6). Where the integrator was restarted during the trial (a stop),
+        the incumbent starts anew."""
         kept, self._kept = self._kept, None
         work = self.outputs.work
         if self.order_choice.mode == "trial":
@@ -366,12 +366,10 @@ class _Run:
                 work.t, work.W, work.P = saved
             self.prob.restore_start(start)
             self.n_rollbacks += 1
-            self.hook.reset(t_int)
-            return solver, t_int
+            return solver, t_int, False
         new = self.make_solver(order)
         new.init_step(t_int, y_last, yp_last)
-        self.hook.reset(t_int)
-        return new, t_int
+        return new, t_int, True
 
     def _restart(self, solver, t_stop: float, y_last, before, more: bool) -> None:
         """A stop (support velocity jump, or the end of a record): a consistent restart

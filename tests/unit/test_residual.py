@@ -157,7 +157,9 @@ def test_an_output_leaves_the_residual_as_it_was(axial):
             prob.observe(T + 0.01, y + 1e-3, yp)
             after = prob.start_state()
             assert after[1] is before[1]  # the same (t, q) the buffers hold
-            for a, b in zip(before[2], after[2], strict=True):
+            assert (before[3] is None) == (not axial)  # the axial damping's chord rates
+            for a, b in zip([*before[2], *(before[3] or ())], [*after[2], *(after[3] or ())],
+                            strict=True):
                 np.testing.assert_array_equal(a, b)
             np.testing.assert_array_equal(before[0], after[0])
         runs.append(residual(prob, T + 0.002, y + 1e-4, yp))
