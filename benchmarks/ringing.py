@@ -65,8 +65,9 @@ def pendulum_case(step_extra: str = "", elements: int = 10, duration: float = 10
         + block(step_extra))
 
 
-def pendulum_figures(ds) -> dict:
-    """Period (mean of the zero crossings of x) and amplitude over the fifth period, with
+def pendulum_figures(ds, periods: float = 5) -> dict:
+    """Period (mean of the zero crossings of x) and amplitude over the ``periods``-th period
+    (from periods - 0.5 to periods + 0.25 reference periods; the fifth by default), with
     their errors against 2π sqrt(l/g) (1 + θ²/16) and the release offset."""
     t = ds.time.values
     x = ds.position.sel(node="B", axis="x").values
@@ -77,7 +78,7 @@ def pendulum_figures(ds) -> dict:
     s = np.flatnonzero(np.sign(x[:-1]) != np.sign(x[1:]))
     tc = t[s] - x[s] * (t[s + 1] - t[s]) / (x[s + 1] - x[s])
     period = 2 * float(np.mean(np.diff(tc)))
-    w = (t > 4.5 * ref) & (t <= 5.25 * ref)
+    w = (t > (periods - 0.5) * ref) & (t <= (periods + 0.25) * ref)
     amp = float(np.max(np.abs(x[w])))
     return {"period": period, "period_ref": ref, "period_err": period / ref - 1,
             "amp_err": amp / x[0] - 1}
