@@ -240,13 +240,13 @@ class _Run:
         try:
             self._loop(writer, bar)
         except KeyboardInterrupt as exc:  # goes on after the partial record is attached below
-            self.status = f"interrupted at t = {self.times[max(self.k_done - 1, 0)]:.6g} s"
+            self.status = f"interrupted at {self._reached()}"
             interrupt = exc
         except SolverError as exc:
             self.status = str(exc)
         except Exception as exc:  # nothing lost: keep what was computed, say what went wrong
-            self.status = (f"stopped after t = {self.times[max(self.k_done - 1, 0)]:.6g} s by "
-                           f"an unexpected error: {type(exc).__name__}: {exc}")
+            self.status = (f"stopped after {self._reached()} by an unexpected error: "
+                           f"{type(exc).__name__}: {exc}")
         finally:
             bar.close()
         rec = self.snapshot(self.k_done)
@@ -257,6 +257,15 @@ class _Run:
             raise SolverError(f"transient step '{self.step.name}': {self.status}",
                               termination=self.status, partial=rec)
         return rec
+
+    def _reached(self) -> str:
+        """How far a stopped run got, and the last output where it had gone past it (the
+        steps after that are in the tension envelope, not in the histories)."""
+        last = float(self.times[max(self.k_done - 1, 0)])
+        t = max(last, getattr(getattr(self, "hook", None), "t_seen", last))
+        if t <= last:
+            return f"t = {last:.6g} s"
+        return f"t = {t:.6g} s (histories up to the output at t = {last:.6g} s)"
 
     def _stops(self):
         """Kinks and jumps of the prescribed motions and loads: the integrator stops at each and
@@ -308,7 +317,7 @@ class _Run:
                 t_int, first = t_new, False
                 continue
             if not res.success:
-                self.status = f"IDA stopped at t = {t_int:.6g} s: {res.message}"
+                self.status = f"IDA stopped at {self._reached()}: {res.message}"
                 return
             t_int = t_new
             if ((t_stop < t_end or end_jump)

@@ -233,3 +233,68 @@ def test_failed_runs_never_overwrite_an_earlier_failed_file(tmp_path, monkeypatc
     assert (tmp_path / "three.failed.nc").read_bytes() == b"earlier failure"
     tree = catdae.read_results(tmp_path / "three.failed-2.nc")
     assert tree.attrs["status"].startswith("failed in step 'modes'")
+
+
+_SPARSE = """
+title = "a weight on a short line, one output at the end"
+[materials.line]
+EA = 1.0e7
+mass = 1.0
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [0.0, 0.0, -10.0]
+[supports]
+A = "pinned"
+[[cables]]
+name = "c"
+ends = ["A", "B"]
+material = "line"
+length = 10.0
+elements = 2
+[[point_masses]]
+name = "bob"
+node = "B"
+mass = 100.0
+[[loads]]
+name = "hold"
+node = "B"
+force = [500.0, 0.0, 0.0]
+[[steps]]
+kind = "static"
+name = "held"
+[[steps]]
+kind = "transient"
+name = "swing"
+remove = ["hold"]
+duration = 2.0
+output_interval = 2.0
+"""
+
+
+def test_an_interrupt_between_outputs_says_how_far_the_integration_got(tmp_path, monkeypatch):
+    """IDA returns only at output times: an interrupt after the last output but well into the
+    integration says the time the integration had reached and the last output kept (the
+    steps after it are in the tension envelope), not only the output's time."""
+    from catdae.solvers.step_hook import StepHook
+
+    real_step = StepHook._step
+
+    def interrupt_after_half_a_second(self, t, y, yp):
+        real_step(self, t, y, yp)
+        if t > 0.5:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(StepHook, "_step", interrupt_after_half_a_second)
+    case = tmp_path / "sparse.toml"
+    case.write_text(_SPARSE)
+    with pytest.raises(KeyboardInterrupt) as info:
+        catdae.analysis.run(case)
+    ds = info.value.partial["swing"].to_dataset()
+    status = ds.attrs["status"]
+    assert status.startswith("interrupted at t = ")
+    reached = float(status.split("t = ")[1].split(" s")[0])
+    assert 0.5 < reached < 2.0, status
+    assert status.endswith("(histories up to the output at t = 0 s)")
+    assert ds.time.values.tolist() == [0.0]
+    # the envelope saw the steps after the output, up to the time reached
+    assert 0.0 < float(ds.time_tension_max.max()) <= reached
