@@ -16,6 +16,7 @@ on a small mesh.
 from __future__ import annotations
 
 import math
+import time
 
 STALL_STEP = 1e-12  # a step shorter than this (relative to t or the output interval) ...
 STALL_COUNT = 200  # ... this many times in a row stops the step as stuck
@@ -39,6 +40,10 @@ class StepHook:
                                          and run.order_choice.measuring) else None
         self.dt_out = run.dt_out
         self.tout = self.tstop = math.nan
+        # a snapshot of the run so far is due every write_every s of wall time (None: no
+        # writer), at the wall time ``due``; between two outputs the hook asks IDA to return
+        self.write_every: float | None = None
+        self.due = math.inf
         self.reset(run.t0)
 
     def reset(self, t: float) -> None:
@@ -46,6 +51,7 @@ class StepHook:
         self.t_seen = self.t_prev = t
         self.t_flag = None  # the step end at which IDA is asked to return
         self.new_order = None  # the order cap the race chose there
+        self.snapshot = False  # IDA returns there for a snapshot
         self.stalled = 0
         self.stuck = False
 
@@ -56,6 +62,24 @@ class StepHook:
         """The order cap asked for at the flagged step (None: a stall), and the flag cleared."""
         new, self.new_order, self.t_flag = self.new_order, None, None
         return new
+
+    def written(self, every: float | None = None) -> None:
+        """A snapshot was written (or snapshots begin, every ``every`` s): the next is due
+        write_every s of wall time from now."""
+        if every is not None:
+            self.write_every = every
+        if self.write_every is not None:
+            self.due = time.perf_counter() + self.write_every
+
+    def snapshot_due(self) -> bool:
+        return time.perf_counter() > self.due
+
+    def take_snapshot(self) -> bool:
+        """Whether IDA returned for a snapshot (the flag then cleared: IDA goes on as it was)."""
+        if not self.snapshot:
+            return False
+        self.snapshot, self.t_flag = False, None
+        return True
 
     def __call__(self, t, y, yp, events):
         if t > self.t_seen and self.t_flag is None:
@@ -80,4 +104,6 @@ class StepHook:
             new = self.race.observe(t)
             if new is not None:
                 self.new_order, self.t_flag = new, t
+        if self.t_flag is None and t != self.tstop and time.perf_counter() > self.due:
+            self.snapshot, self.t_flag = True, t  # a long stretch between outputs
         self.bar.update(t)

@@ -4,9 +4,8 @@ The only module that imports sksundae. ``run_transient`` integrates one transien
 builds the residual and iteration matrix (``residual.TransientProblem``), picks the linear
 solver, the tolerances and the BDF order cap, calls IDA once per output time with the per-step
 work in its root function (``step_hook.StepHook``), stops and restarts at the kinks and jumps
-of prescribed motions and loads, records the output times
-(``record.OutputRecord``, arrays: datasets are made in ``catdae.output``) and keeps what was
-computed when a run fails or is interrupted. Its phases, in order: output times, IDA options
+of prescribed motions and loads, records the output times (``record.OutputRecord``) and keeps
+what was computed when a run fails or is interrupted. Its phases: output times, IDA options
 (linear solver, tolerances, order), the consistent start, the integration loop, attributes.
 
 BDF order (``max_order = "auto"``, the default): OrderChoice races orders 5 and 2, a window of
@@ -28,11 +27,7 @@ from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.model.snap import jump_floor, velocity_jumps
 from catdae.progress import reporter
-from catdae.solvers.order import (
-    OrderChoice,
-    highest_frequency,
-    reference_frequency,
-)
+from catdae.solvers.order import OrderChoice, highest_frequency, reference_frequency
 from catdae.solvers.record import OutputRecord, note
 from catdae.solvers.residual import TransientProblem
 from catdae.solvers.step_hook import StepHook
@@ -40,17 +35,11 @@ from catdae.solvers.tolerance import error_weights, resolve_mode
 
 
 def _import_ida():
-    """sksundae's IDA, without importing all of scipy.optimize for one helper.
-
-    scikit-sundae 1.2's compiled IDA module imports ``group_columns`` from
-    ``scipy.optimize._numdiff`` at its own import (it colours a sparsity pattern for finite-
-    difference Jacobians, which catdae never asks for: it gives the iteration matrix), and that
-    imports the whole of scipy.optimize: about 0.19 s of CPU in every transient process
-    (benchmarks/startup.md). While sksundae is imported, that module name is held by a stand-in
-    whose ``group_columns`` imports the real one at its first call and which hands any other
-    name over to the real module; the stand-in is taken out of ``sys.modules`` right after, so
-    any later import of scipy.optimize is the real one. Where the stand-in does not do (another
-    sksundae), sksundae is imported the ordinary way."""
+    """sksundae's IDA, without importing all of scipy.optimize (0.19 s of CPU per process,
+    benchmarks/startup.md) for ``group_columns``, which scikit-sundae 1.2 imports for finite-
+    difference Jacobians catdae never asks for. While sksundae is imported a stand-in holds
+    ``scipy.optimize._numdiff`` (its ``group_columns`` and any other name go to the real module
+    at first use) and leaves ``sys.modules`` right after; otherwise the ordinary import."""
     name = "scipy.optimize._numdiff"
     if name in sys.modules or "sksundae.ida" in sys.modules:
         from sksundae.ida import IDA
@@ -259,13 +248,11 @@ class _Run:
         return rec
 
     def _reached(self) -> str:
-        """How far a stopped run got, and the last output where it had gone past it (the
-        steps after that are in the tension envelope, not in the histories)."""
+        """How far a stopped run got, and the last output where it had gone past it."""
         last = float(self.times[max(self.k_done - 1, 0)])
         t = max(last, getattr(getattr(self, "hook", None), "t_seen", last))
-        if t <= last:
-            return f"t = {last:.6g} s"
-        return f"t = {t:.6g} s (histories up to the output at t = {last:.6g} s)"
+        tail = "" if t <= last else f" (histories up to the output at t = {last:.6g} s)"
+        return f"t = {t:.6g} s{tail}"
 
     def _stops(self):
         """Kinks and jumps of the prescribed motions and loads: the integrator stops at each and
@@ -283,20 +270,13 @@ class _Run:
     def _loop(self, writer, bar) -> None:
         """IDA once per output time (or stop); the per-step work runs inside IDA, in the
         root function ``StepHook`` (docs/theory.md §8.8), which also asks IDA to return at a
-        step's end where the order race changes the order cap or the step size collapsed."""
+        step's end where the order race changes the order cap, the step size collapsed, or a
+        snapshot is due (INCREMENT_SECONDS of wall time without one)."""
         times, t_end = self.times, self.t_end
-        hook = self.hook = StepHook(self, bar)
-        solver = self.make_solver(self.options["max_order"])
-        solver.init_step(self.t0, self.y0, self.yp0)
-        self.outputs.record(0, self.t0, self.y0, self.yp0)
-        work = self.outputs.work  # the fluid's work, None without a fluid
-        if work is not None:
-            work.advance(self.t0, self.y0, self.yp0)
-        self.k_done = 1
+        hook, solver = self._begin(writer, bar)
         t_int = self.t0
         stops, befores, end_jump = self._stops()
         i_stop = 0
-        last_write = _time.perf_counter()
         first = True  # IDA's first step after a start is aimed at the stop (below)
         while self.k_done < times.size:
             t_stop = stops[i_stop]
@@ -309,6 +289,10 @@ class _Run:
                 res = solver.step(tout, method="normal", tstop=t_stop)
             t_new = float(res.t)
             if res.status == IDA_ROOT_RETURN:  # the hook asked IDA to return at a step's end
+                if hook.take_snapshot():  # long between outputs: the run so far, IDA goes on
+                    self._write_snapshot(writer)
+                    first = False  # a step was taken
+                    continue
                 solver, t_int, first = self._hook_stop(solver, res)
                 if solver is None:
                     return
@@ -334,9 +318,25 @@ class _Run:
             else:
                 first = False
             bar.update(t_int)
-            if writer is not None and _time.perf_counter() - last_write > INCREMENT_SECONDS:
-                writer.write_increment(self.step.name, self.snapshot(self.k_done))
-                last_write = _time.perf_counter()
+            if hook.snapshot_due():
+                self._write_snapshot(writer)
+
+    def _begin(self, writer, bar):
+        """The hook and IDA at the step's start, its output recorded: (hook, IDA)."""
+        hook = self.hook = StepHook(self, bar)
+        if writer is not None and writer.output is not None:
+            hook.written(every=INCREMENT_SECONDS)  # snapshots of a long run
+        solver = self.make_solver(self.options["max_order"])
+        solver.init_step(self.t0, self.y0, self.yp0)
+        self.outputs.record(0, self.t0, self.y0, self.yp0)
+        if self.outputs.work is not None:  # the fluid's work, None without a fluid
+            self.outputs.work.advance(self.t0, self.y0, self.yp0)
+        self.k_done = 1
+        return hook, solver
+
+    def _write_snapshot(self, writer) -> None:  # of the run so far
+        writer.write_increment(self.step.name, self.snapshot(self.k_done))
+        self.hook.written()
 
     def _hook_stop(self, solver, res):
         """IDA returned where the hook asked (a step's end): the order race changed the order

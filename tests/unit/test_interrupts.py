@@ -298,3 +298,32 @@ def test_an_interrupt_between_outputs_says_how_far_the_integration_got(tmp_path,
     assert ds.time.values.tolist() == [0.0]
     # the envelope saw the steps after the output, up to the time reached
     assert 0.0 < float(ds.time_tension_max.max()) <= reached
+
+
+def test_snapshots_come_between_outputs_and_leave_the_run_as_it_was(tmp_path, monkeypatch):
+    """A long stretch without outputs still gets its snapshots (every INCREMENT_SECONDS of
+    wall time; 0.02 s here): the hook asks IDA to return at a step's end, the snapshot is
+    written and IDA goes on as it was, so the run is the one without snapshots (no output
+    file, none asked for), step for step."""
+    from catdae.output.writer import ResultWriter
+    from catdae.solvers import transient
+
+    case = tmp_path / "sparse.toml"
+    case.write_text(_SPARSE)
+    plain = catdae.analysis.run(case)["swing"].to_dataset()
+    monkeypatch.setattr(transient, "INCREMENT_SECONDS", 0.02)
+    outputs_then = []
+    real = ResultWriter.write_increment
+
+    def record(self, name, rec):
+        outputs_then.append(rec.n_valid)
+        return real(self, name, rec)
+
+    monkeypatch.setattr(ResultWriter, "write_increment", record)
+    snapped = catdae.analysis.run(case, output=tmp_path / "s.nc")["swing"].to_dataset()
+    assert plain.time.values.tolist() == [0.0, 2.0]
+    assert outputs_then.count(1) >= 3, outputs_then  # between the two outputs
+    assert snapped.attrs["n_steps"] == plain.attrs["n_steps"]
+    for name in ("position", "velocity", "tension", "tension_max", "time_tension_max"):
+        np.testing.assert_array_equal(snapped[name].values, plain[name].values, err_msg=name)
+    assert not (tmp_path / "s.partial.nc").exists()  # removed at the end

@@ -104,3 +104,19 @@ def test_a_collapsed_step_size_stops_the_run():
     for k in range(2 * STALL_COUNT):  # short steps broken by a normal one: not stuck
         t += 1e-3 if k % 100 == 99 else 1e-14
         assert _call(hook2, t) == 1.0
+
+
+def test_a_due_snapshot_is_a_root_at_a_step_end_only():
+    hook, run = _hook()
+    hook.aim(0.1, 1.0)
+    hook.written(every=0.0)  # due at once
+    assert _call(hook, 0.1) == 1.0  # the output at 0.1 is not a step: no return for it
+    assert _call(hook, 0.12) == -1.0  # a step end: IDA returns there
+    assert hook.take_snapshot() and not hook.take_snapshot()
+    assert _call(hook, 0.12) == 1.0  # IDA's check at the return: the sign is back
+    hook.written(every=1e9)  # the next far off
+    assert _call(hook, 0.15) == 1.0 and not hook.take_snapshot()
+    hook.written(every=0.0)
+    hook.aim(1.0, 1.0)
+    assert _call(hook, 1.0) == 1.0  # the stop: IDA returns there anyway
+    assert run.n_steps == 3
