@@ -61,7 +61,17 @@ class StepHook:
     def take_order(self) -> int | None:
         """The order cap asked for at the flagged step (None: a stall), and the flag cleared."""
         new, self.new_order, self.t_flag = self.new_order, None, None
+        self._forget_returns()
         return new
+
+    def _forget_returns(self) -> None:
+        """Empty the lists in which scikit-sundae keeps every root return (on this object, its
+        ``eventsfn``): it turns them into arrays at each call of IDA, a cost that would grow
+        with every return of a long run (a snapshot every 20 s); catdae does not read them."""
+        for name in ("_i", "_t", "_y", "_yp"):
+            kept = getattr(self, name, None)
+            if isinstance(kept, list):
+                kept.clear()
 
     def written(self, every: float | None = None) -> None:
         """A snapshot was written (or snapshots begin, every ``every`` s): the next is due
@@ -79,6 +89,7 @@ class StepHook:
         if not self.snapshot:
             return False
         self.snapshot, self.t_flag = False, None
+        self._forget_returns()
         return True
 
     def __call__(self, t, y, yp, events):

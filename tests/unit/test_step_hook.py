@@ -120,3 +120,19 @@ def test_a_due_snapshot_is_a_root_at_a_step_end_only():
     hook.aim(1.0, 1.0)
     assert _call(hook, 1.0) == 1.0  # the stop: IDA returns there anyway
     assert run.n_steps == 3
+
+
+def test_the_wrappers_record_of_returns_does_not_grow():
+    """scikit-sundae appends every root return to lists on its eventsfn and converts them to
+    arrays at each IDA call: the hook empties them when the driver takes a return."""
+    hook, _ = _hook()
+    for name in ("_i", "_t", "_y", "_yp"):
+        setattr(hook, name, [np.zeros(2)] * 3)
+    hook.written(every=0.0)
+    hook.aim(0.1, 1.0)
+    assert _call(hook, 0.05) == -1.0 and hook.take_snapshot()
+    assert all(getattr(hook, name) == [] for name in ("_i", "_t", "_y", "_yp"))
+    for name in ("_i", "_t", "_y", "_yp"):
+        setattr(hook, name, [np.zeros(2)])
+    hook.take_order()
+    assert all(getattr(hook, name) == [] for name in ("_i", "_t", "_y", "_yp"))
