@@ -63,13 +63,15 @@ class ResultWriter:
         with deferred():
             results.write_tree(tree, path)
 
-    def write_increment(self, name: str, ds) -> None:
+    def write_increment(self, name: str, ds, reached: str | None = None) -> None:
         """A readable snapshot of the run so far (a dataset or a transient's output record),
-        beside the output (never over it)."""
+        beside the output (never over it); ``reached``: how far the step got ("t = ... s"),
+        by default the last output time."""
         if self.output is None:
             return
         ds = as_dataset(ds)
-        t = f" at t = {float(ds.time[-1]):.6g} s" if ds.sizes.get("time") else ""
+        t = (f" at {reached}" if reached else
+             f" at t = {float(ds.time[-1]):.6g} s" if ds.sizes.get("time") else "")
         ds = ds.assign_attrs(status=f"running (snapshot{t}; the step has not finished)")
         tree = results.make_tree(self.case, {**self.groups,
                                              name: rotate_back(ds, self.rotation)},

@@ -335,7 +335,7 @@ class _Run:
         return hook, solver
 
     def _write_snapshot(self, writer) -> None:  # of the run so far
-        writer.write_increment(self.step.name, self.snapshot(self.k_done))
+        writer.write_increment(self.step.name, self.snapshot(self.k_done), self._reached())
         self.hook.written()
 
     def _hook_stop(self, solver, res):

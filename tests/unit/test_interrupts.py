@@ -312,17 +312,23 @@ def test_snapshots_come_between_outputs_and_leave_the_run_as_it_was(tmp_path, mo
     case.write_text(_SPARSE)
     plain = catdae.analysis.run(case)["swing"].to_dataset()
     monkeypatch.setattr(transient, "INCREMENT_SECONDS", 0.02)
-    outputs_then = []
+    outputs_then, statuses = [], []
     real = ResultWriter.write_increment
 
-    def record(self, name, rec):
+    def record(self, name, rec, reached=None):
         outputs_then.append(rec.n_valid)
-        return real(self, name, rec)
+        real(self, name, rec, reached)
+        statuses.append(catdae.read_results(self.partial_path)["swing"].attrs["status"])
 
     monkeypatch.setattr(ResultWriter, "write_increment", record)
     snapped = catdae.analysis.run(case, output=tmp_path / "s.nc")["swing"].to_dataset()
     assert plain.time.values.tolist() == [0.0, 2.0]
     assert outputs_then.count(1) >= 3, outputs_then  # between the two outputs
+    # each says how far the step had got, and that its histories end at the first output
+    head, tail = "running (snapshot at t = ", " s (histories up to the output at t = 0 s); "
+    between = [float(x[len(head):x.index(tail)]) for x in statuses if tail in x]
+    assert len(between) >= 3 and all(x.startswith(head) for x in statuses), statuses
+    assert 0.0 < between[0] < between[-1] < 2.0
     assert snapped.attrs["n_steps"] == plain.attrs["n_steps"]
     for name in ("position", "velocity", "tension", "tension_max", "time_tension_max"):
         np.testing.assert_array_equal(snapped[name].values, plain[name].values, err_msg=name)
