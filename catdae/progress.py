@@ -140,7 +140,9 @@ class LogProgress:
     def _line(self, now: float, done: bool = False, note: str = "") -> None:
         span = self.t_end - self.t0
         pct = 100.0 * (self.t - self.t0) / span if span > 0 else 100.0
-        end = ", done" if done else ""
+        # the last line: "done" where the step got to its end, "stopped" where it did not
+        finished = self.t >= self.t_end - 1e-9 * max(abs(self.t_end), span, 1e-300)
+        end = (", done" if finished else ", stopped") if done else ""
         stream = self.stream if self.stream is not None else sys.stderr
         print(f"catdae: {self.name}: t = {self.t:.6g} / {self.t_end:.6g} s ({pct:.0f} %), "
               f"{now - self.start:.1f} s wall{note}{end}", file=stream, flush=True)

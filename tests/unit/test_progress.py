@@ -13,7 +13,7 @@ from catdae.progress import LogProgress
 from repo_paths import CASES  # noqa: E402
 
 LINE = re.compile(r"catdae: (\w+): t = ([0-9.e+-]+) / ([0-9.e+-]+) s \((\d+) %\), "
-                  r"([0-9.]+) s wall(, done)?$")
+                  r"([0-9.]+) s wall(, done|, stopped)?$")
 
 
 class Clock:
@@ -62,3 +62,17 @@ def test_a_transient_run_logs_its_progress_when_stderr_is_not_a_terminal(monkeyp
     assert t_end > 0 and lines[-1][6] == ", done" and float(lines[-1][2]) == t_end
     ts = [float(m[2]) for m in lines]
     assert ts == sorted(ts) and ts[0] < t_end
+
+
+def test_the_last_line_of_a_step_that_did_not_reach_its_end_says_stopped():
+    """An interrupted or failed step closes its reporter before its end: its last line says
+    so ("stopped"), not "done"."""
+    clock, out = Clock(), io.StringIO()
+    rep = LogProgress("release", 0.0, 4.0, interval=10.0, stream=out, clock=clock)
+    clock.now = 111.0
+    rep.update(1.3)
+    clock.now = 112.0
+    rep.close()
+    lines = [LINE.match(s) for s in out.getvalue().splitlines()]
+    assert all(lines) and [m[6] for m in lines] == [None, ", stopped"], out.getvalue()
+    assert float(lines[-1][2]) == 1.3

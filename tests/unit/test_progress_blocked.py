@@ -24,7 +24,7 @@ from catdae.progress import LogProgress, announce_compiling, reporter
 from scene_toml import cable_scene, step
 
 LINE = re.compile(r"catdae: (\w+): t = ([0-9.e+-]+) / ([0-9.e+-]+) s \((\d+) %\), "
-                  r"([0-9.]+) s wall(, compiling the kernels)?(, done)?$")
+                  r"([0-9.]+) s wall(, compiling the kernels)?(, done|, stopped)?$")
 
 
 def test_lines_come_while_the_step_is_blocked_in_one_call():
@@ -36,7 +36,7 @@ def test_lines_come_while_the_step_is_blocked_in_one_call():
     lines = [LINE.match(s) for s in out.getvalue().splitlines()]
     assert len(lines) >= 4 and all(lines), out.getvalue()
     assert all(float(m[2]) == 0.5 for m in lines)
-    assert lines[-1][7] == ", done"
+    assert lines[-1][7] == ", stopped"  # closed at t = 0.5 of 2: not done
     n = len(lines)
     time.sleep(0.2)  # closed: the ticker has stopped
     assert len(out.getvalue().splitlines()) == n
@@ -73,7 +73,7 @@ def test_a_reporter_for_a_log_ticks_and_stops(monkeypatch):
     time.sleep(0.3)
     rep.close()
     text = sys.stderr.getvalue()
-    assert len(text.splitlines()) >= 3 and text.rstrip().endswith(", done"), text
+    assert len(text.splitlines()) >= 3 and text.rstrip().endswith(", stopped"), text
 
 
 def test_catdae_run_into_a_log_file(tmp_path):
