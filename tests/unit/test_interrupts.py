@@ -29,6 +29,7 @@ from catdae.cli import main
 
 from processes import catdae_process, interrupted_run, long_case, signal_when
 from repo_paths import CASES  # noqa: E402
+from scene_toml import cable_scene, load, point_mass, step
 
 THREE = CASES / "three_cables_shared_node.toml"
 
@@ -235,40 +236,13 @@ def test_failed_runs_never_overwrite_an_earlier_failed_file(tmp_path, monkeypatc
     assert tree.attrs["status"].startswith("failed in step 'modes'")
 
 
-_SPARSE = """
-title = "a weight on a short line, one output at the end"
-[materials.line]
-EA = 1.0e7
-mass = 1.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [0.0, 0.0, -10.0]
-[supports]
-A = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "line"
-length = 10.0
-elements = 2
-[[point_masses]]
-name = "bob"
-node = "B"
-mass = 100.0
-[[loads]]
-name = "hold"
-node = "B"
-force = [500.0, 0.0, 0.0]
-[[steps]]
-kind = "static"
-name = "held"
-[[steps]]
-kind = "transient"
-name = "swing"
-remove = ["hold"]
-duration = 2.0
-output_interval = 2.0
-"""
+# a weight on a short line, held aside, then let go: one output at the end of the swing
+_SPARSE = cable_scene(
+    B=(0.0, 0.0, -10.0), L0=10.0, EA=1.0e7, mass=1.0, elements=2, supports=("A",),
+    title="a weight on a short line, one output at the end",
+    extra=point_mass("bob", 100.0, node="B") + load("hold", [500.0, 0.0, 0.0], node="B"),
+    steps=step("static", "held") + step("transient", "swing", remove=["hold"], duration=2.0,
+                                        output_interval=2.0))
 
 
 def test_an_interrupt_between_outputs_says_how_far_the_integration_got(tmp_path, monkeypatch):
