@@ -127,6 +127,10 @@ class TensionEnvelope:
         self.n_solved = 0  # updates that solved every element afresh
         self.n_elements_solved = 0  # elements solved again in carried updates
         self._out = np.zeros((ne, 2))
+        # read-only, as IDA's y: the same compiled signature of carried_tensions (one kernel
+        # load per process, not two)
+        self._y_unused = self._X.view()
+        self._y_unused.flags.writeable = False
         self._zero_cd = np.zeros(ne)
         self._zero_g = np.zeros((ne, 3))
 
@@ -192,5 +196,5 @@ class TensionEnvelope:
             if tension is None:
                 return
         # y is unused without the carry: any 1-D float array
-        self._take(t, self._X, False, np.ascontiguousarray(tension, float))
+        self._take(t, self._y_unused, False, np.ascontiguousarray(tension, float))
         self.n_updates += 1
