@@ -81,7 +81,7 @@ class StepHook:
         if self.write_every is not None:
             self.due = time.perf_counter() + self.write_every
 
-    def snapshot_due(self) -> bool:
+    def snapshot_due(self) -> bool:  # (inlined in _step, which runs at every step)
         return time.perf_counter() > self.due
 
     def take_snapshot(self) -> bool:

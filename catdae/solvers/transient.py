@@ -289,11 +289,7 @@ class _Run:
                 res = solver.step(tout, method="normal", tstop=t_stop)
             t_new = float(res.t)
             if res.status == IDA_ROOT_RETURN:  # the hook asked IDA to return at a step's end
-                if hook.take_snapshot():  # long between outputs: the run so far, IDA goes on
-                    self._write_snapshot(writer)
-                    first = False  # a step was taken
-                    continue
-                solver, t_int, first = self._hook_stop(solver, res)
+                solver, t_int, first = self._hook_stop(solver, res, writer)
                 if solver is None:
                     return
                 continue
@@ -338,12 +334,16 @@ class _Run:
         writer.write_increment(self.step.name, self.snapshot(self.k_done), self._reached())
         self.hook.written()
 
-    def _hook_stop(self, solver, res):
-        """IDA returned where the hook asked (a step's end): the order race changed the order
-        cap, or the step size collapsed (status set, solver None). Returns (the IDA to go on
-        with, its time, whether it is new: its first step is then aimed at the stop)."""
-        new_order = self.hook.take_order()
+    def _hook_stop(self, solver, res, writer):
+        """IDA returned where the hook asked (a step's end): a snapshot is due (written; the
+        same IDA goes on as if it had not returned), the order race changed the order cap, or
+        the step size collapsed (status set, solver None). Returns (the IDA to go on with, its
+        time, whether it is new: its first step is then aimed at the stop)."""
         t = float(res.t)
+        if self.hook.take_snapshot():  # a long stretch between outputs: the run so far
+            self._write_snapshot(writer)
+            return solver, t, False
+        new_order = self.hook.take_order()
         if new_order is None:
             self.status = (f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
                            f"{self.prob.n_rejected} trial states rejected)")
