@@ -192,13 +192,14 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
     state.__dict__.update(run_state.__dict__)
     field = step.sweep.field
     ds = xr.concat(groups, dim="sweep", combine_attrs="drop_conflicts")
-    for key in {k for g in groups for k in g.attrs} - set(ds.attrs):  # differ by value
+    varying = sorted({k for g in groups for k in g.attrs} - set(ds.attrs))  # differ by value
+    for key in varying:
         values = [g.attrs.get(key, "") for g in groups]
         numbers = all(isinstance(v, int | float | np.number) for v in values)
         ds.attrs[key] = np.array(values) if numbers else " | ".join(map(str, values))
     ds = ds.assign_coords(sweep=xr.Variable("sweep", np.array(step.sweep.values), {
         "units": sweep_units(field), "long_name": f"swept value of {field}"}))
-    return ds.assign_attrs(sweep_field=field), temp_v
+    return ds.assign_attrs(sweep_field=field, sweep_attributes=" ".join(varying)), temp_v
 
 
 def step_model(case: Case, mesh, absent: set[str], step: Step, state: _State) -> Model:
@@ -282,16 +283,25 @@ def engineering_results(step: Step, ds: xr.Dataset, case: Case,
     ``temperature_change`` (K) and, with the case's ``reference_temperature``, ``temperature``;
     a transient group also with its envelopes and, after a ``jump_reference`` static step,
     the jump of each cable (catdae.output.engineering)."""
+    if step.sweep is not None and step.sweep.field == "temperature_change":
+        temperature = np.array(step.sweep.values)  # one per value (the sweep's attributes)
+        ds.attrs["sweep_attributes"] = " ".join(sorted(
+            {*ds.attrs["sweep_attributes"].split(), "temperature_change", "temperature"}))
     if not isinstance(temperature, dict) and not hasattr(temperature, "items"):
-        ds = ds.assign_attrs(temperature_change=float(temperature))
+        ds = ds.assign_attrs(temperature_change=_number(temperature))
         if case.reference_temperature is not None:
-            ds = ds.assign_attrs(temperature=case.reference_temperature + float(temperature))
+            ds = ds.assign_attrs(temperature=_number(case.reference_temperature + temperature))
     if step.kind != "transient":
         return ds
     ref = groups.get(step.jump_reference) if step.jump_reference else None
     if ref is not None:
         ds = ds.assign_attrs(jump_reference=step.jump_reference)
     return engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
+
+
+def _number(x):
+    """A float, or an array of them over the values of a sweep."""
+    return x.astype(float) if isinstance(x, np.ndarray) else float(x)
 
 
 def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:

@@ -23,6 +23,7 @@ from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CaseError, CatdaeError, OutputError, ResultsError
 from catdae.interrupts import signals_as_interrupts
 from catdae.output.files import check_folder
+from catdae.output.reading import step_values
 from catdae.progress import say
 
 # catdae.output.plot.WHAT
@@ -254,13 +255,8 @@ def summary(tree) -> str:
             continue
         field = ds.attrs.get("sweep_field", "sweep")
         lines.append(f"[{name}] swept over {field}: {ds.sizes['sweep']} values")
-        n = ds.sizes["sweep"]
-        for k, value in enumerate(ds.sweep.values):
-            one = ds.isel(sweep=k)
-            one.attrs = {key: v[k] if np.ndim(v) == 1 and len(v) == n else
-                         v.split(" | ")[k] if isinstance(v, str) and v.count(" | ") == n - 1
-                         else v for key, v in ds.attrs.items()}
-            lines.extend(_step_lines(f"{name} {field} = {float(value):.6g}", one))
+        for _, one in step_values(name, ds):
+            lines.extend(_step_lines(f"{name} {one.attrs['sweep_value']}", one))
     return "\n".join(lines)
 
 

@@ -90,8 +90,7 @@ class Model(MassMatrices):
         self.mass_model = choose_mass_model(mass_model, kind, ends, snap)
         # springs, dampers, bars (None when the scene has none); bar weights and lumped
         # masses go into the loading
-        self.connectors = build_connectors(case, mesh, self.loading,
-                                           self.mass_model.lumped_fraction)
+        self.connectors = build_connectors(case, mesh, self.loading)
         nn = mesh.n_nodes
         self.n_dof = 3 * nn
         fixed = np.zeros((nn, 3), bool)

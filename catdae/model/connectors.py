@@ -16,11 +16,12 @@ strain of a bar is (d - L) / L of its current length). Their derivatives are ana
 and ∂r/∂(x_a, v_a) = -∂r/∂(x_b, v_b), r_a = -r_b, which fills the 6x6 block [[K, -K], [-K, K]].
 
 A bar has a mass m L (``mass`` per metre times its length). Its weight m L g is split half to
-each end (the exact work of a uniform weight on a linear interpolation), and so is its lumped
-mass; with a consistent mass the rest of m L / 6 [[2, 1], [1, 2]] ⊗ I is the correction
-ρ [[-1, 1], [1, -1]] ⊗ I, ρ = (1 - μ) m L / 6, where μ is the lumped fraction of the step's
-mass model (1 lumped, ½ blended, 0 consistent and linear). The halves go into the step's nodal
-masses and loads (so every solver sees them with no change), the correction comes from here.
+each end (the exact work of a uniform weight on a linear interpolation). Its mass is the
+consistent mass of a straight uniform bar, m L / 6 [[2, 1], [1, 2]] ⊗ I, whatever the step's
+mass model: it is exact for the bar's rigid motion (its swing), and a bar is one member that no
+mesh refines, so a lumped part would stay an error (docs/theory.md §15). It is written as the
+halves m L / 2, which go into the step's nodal masses (every solver sees them with no change),
+plus the correction ρ [[-1, 1], [1, -1]] ⊗ I, ρ = m L / 6, which comes from here.
 """
 
 from __future__ import annotations
@@ -141,7 +142,7 @@ def _pair(k3: np.ndarray) -> np.ndarray:
     return np.concatenate([top, -top], axis=1)
 
 
-def build_connectors(case, mesh, loading, lumped_fraction: float) -> Connectors | None:
+def build_connectors(case, mesh, loading) -> Connectors | None:
     """The connectors of ``case`` on ``mesh`` (None when there are none). The halves of the
     bars' weight and lumped mass are added to ``loading`` (its node_force and node_mass)."""
     items = [("spring", s) for s in case.springs] + [("damper", d) for d in case.dampers]
@@ -175,7 +176,7 @@ def build_connectors(case, mesh, loading, lumped_fraction: float) -> Connectors 
         np.add.at(loading.node_force[:, 2], ends[:, 0], -case.gravity * half)
         np.add.at(loading.node_force[:, 2], ends[:, 1], -case.gravity * half)
     return Connectors(tuple(x.name for _, x in items), tuple(kind for kind, _ in items), ends,
-                      k, rest, c, (1.0 - lumped_fraction) * mass / 6.0)
+                      k, rest, c, mass / 6.0)
 
 
 def with_connectors(edofs: np.ndarray, connectors: Connectors | None) -> np.ndarray:

@@ -123,11 +123,12 @@ class MassMatrices:
     def mass_data(self, state: ElementState) -> np.ndarray:
         """CSR data of the mass matrix M(q) on the full dof set."""
         if self.mass_model.lumped:
-            return self.pattern.assemble(None, self.lumped_mass_diag())
-        me = self.element_mass(state)
+            me, diag = None, self.lumped_mass_diag()
+        else:
+            me, diag = self.element_mass(state), self.diagonal_mass()
         if self.connectors is not None:  # the bars' consistent-mass correction (theory §15)
             me = extend(me, self.connectors.mass_blocks(), self.mesh.n_elements)
-        return self.pattern.assemble(me, self.diagonal_mass())
+        return self.pattern.assemble(me, diag)
 
     def mass(self, state: ElementState) -> sp.csr_matrix:
         return self.pattern.matrix(self.mass_data(state))

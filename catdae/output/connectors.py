@@ -31,6 +31,8 @@ def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
     ).assign_coords(
         connector=label("connector", connectors.names, "connector name"),
         connector_kind=label("connector", connectors.kinds, "spring, damper or bar"),
+        connector_node=label(("connector", "end"), np.asarray(ds.node.values)[connectors.ends],
+                             "nodes at the connector's ends"),
     )
 
 

@@ -45,10 +45,29 @@ class ExportError(CatdaeError):
     """Results that cannot be exported (no such step, no elements)."""
 
 
-def _cells(ds: xr.Dataset) -> np.ndarray:
-    """(n_elem, 2) node indices of each element's ends, from element_node."""
+def _cells(ds: xr.Dataset, ends: str = "element_node") -> np.ndarray:
+    """(n, 2) node indices of each element's (or connector's: connector_node) ends."""
     index = {str(n): k for k, n in enumerate(ds.node.values)}
-    return np.vectorize(index.__getitem__, otypes=[np.int64])(ds.element_node.values.astype(str))
+    return np.vectorize(index.__getitem__, otypes=[np.int64])(ds[ends].values.astype(str))
+
+
+def _blocks(ds: xr.Dataset, at: xr.Dataset) -> tuple[list, dict]:
+    """The line cells (the elements, then the connectors: ``connector`` 1) with their cell data
+    (a connector's tension is its ``connector_force``) of one time ``at`` of the step ds."""
+    blocks, data = [], {"tension": [], "tension_i": [], "tension_j": [], "connector": []}
+    if ds.sizes.get("element"):
+        tens = at.tension.values  # (n_elem, 2) N
+        blocks.append(("line", _cells(ds)))
+        for key, v in (("tension", tens.mean(axis=1)), ("tension_i", tens[:, 0]),
+                       ("tension_j", tens[:, 1]), ("connector", np.zeros(len(tens)))):
+            data[key].append(v)
+    if "connector_node" in ds.coords and ds.sizes.get("connector"):
+        force = at.connector_force.values  # (n_connector,) N
+        blocks.append(("line", _cells(ds, "connector_node")))
+        for key in ("tension", "tension_i", "tension_j"):
+            data[key].append(force)
+        data["connector"].append(np.ones(len(force)))
+    return blocks, data
 
 
 def _write(f: Path, points, cells, **data) -> None:
@@ -119,17 +138,15 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str, case=None) 
     folder = Path(folder)
     sub = folder / name
     sub.mkdir(parents=True, exist_ok=True)
-    cells = [("line", _cells(ds))]
     times = ds.time.values if "time" in ds.dims else np.array([float(ds.attrs.get("t", 0.0))])
     point_vars = [v for v in ("displacement", "velocity", "acceleration") if v in ds]
     files = []
     for k in range(times.size):
         at = ds.isel(time=k) if "time" in ds.dims else ds
-        tens = at.tension.values  # (n_elem, 2) N
+        cells, cell_data = _blocks(ds, at)
         f = sub / f"{name}_{k:05d}.vtu"
         _write(f, at.position.values, cells, point_data={v: at[v].values for v in point_vars},
-               cell_data={"tension": [tens.mean(axis=1)], "tension_i": [tens[:, 0]],
-                          "tension_j": [tens[:, 1]]})
+               cell_data=cell_data)
         files.append(f)
     # part 0 the cables; parts 1, 2 the seabed and the water surface (one file, or one a time)
     parts = [files, *_environment(ds, sub, name, times, case)]
@@ -156,4 +173,12 @@ def write_vtk(tree: xr.DataTree, folder: str | os.PathLike, steps=None) -> list[
     Path(folder).mkdir(parents=True, exist_ok=True)
     waves = any("surface_elevation" in tree[n].to_dataset() for n in names)
     case = _case_of(tree) if waves else None
-    return [write_step(tree[n].to_dataset(), folder, n, case) for n in names]
+    from catdae.output.reading import step_problem, step_values
+
+    written = []
+    for group in names:  # a swept step: a series per value, <step>-sweep<k>
+        if (why := step_problem(tree[group].to_dataset())) is not None:
+            raise ExportError(f"step {group[:60]!r}: {why}")
+        written += [write_step(ds, folder, name, case)
+                    for name, ds in step_values(group, tree[group].to_dataset())]
+    return written

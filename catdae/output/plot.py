@@ -30,26 +30,14 @@ from catdae.errors import CatdaeError
 from catdae.interrupts import deferred
 from catdae.output.environment import axis_names, drawing_frame, still_levels
 from catdae.output.plot_envelopes import mark_peaks, reactions
+from catdae.output.plot_parts import draw_connectors, label, legend
+from catdae.output.plot_parts import subplots as _subplots
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
 
 class PlotError(CatdaeError):
     """A figure that the data cannot make (no such node, step or time)."""
-
-
-def label(var: xr.DataArray, name: str | None = None) -> str:
-    """'long_name [units]' from the variable's attributes (time: 's')."""
-    text = name or var.attrs.get("long_name", var.name)
-    units = var.attrs.get("units")
-    if units and " since " in str(units).lower():  # CF time: "seconds Since <epoch>"
-        units = str(units)[:str(units).lower().index(" since ")].replace("seconds", "s")
-    return f"{text} [{units}]" if units else str(text)
-
-
-def _subplots(*args, figsize, **kwargs):
-    fig = Figure(figsize=figsize)
-    return fig, fig.subplots(*args, **kwargs)
 
 
 _KINDS = {"profile": ("static", "transient"), "tension": ("static", "transient"),
@@ -71,6 +59,9 @@ def _ds(data, figure: str | None = None) -> xr.Dataset:
         if why is not None:
             raise PlotError(f"cannot draw a {figure} figure of this group: {why}")
         kinds = _KINDS[figure]
+        if "sweep" in data.dims:
+            raise PlotError("a swept step: draw one value, ds.isel(sweep=k) (its attributes: "
+                            "catdae.output.reading.step_values)")
         if data.attrs["kind"] not in kinds:
             raise PlotError(f"a {figure} figure needs a {' or '.join(kinds)} step, found a "
                             f"{data.attrs['kind']} step")
@@ -140,6 +131,7 @@ def profile(data, times=None, what: str = "position") -> Figure:
                 eta = ds.surface_elevation.sel(time=t, node=nodes).values
                 ax_e.plot(pts[:, 0], ds.attrs.get("water_surface", 0.0) + eta,
                           ls="--", lw=0.8, color=line.get_color(), gid=f"surface|{cab}|{t}")
+        draw_connectors(ax_e, ax_p, ds, x, R, t)
     if what == "position":
         still_levels(ax_e, ds)
     name = var.attrs.get("long_name", what)
@@ -149,7 +141,7 @@ def profile(data, times=None, what: str = "position") -> Figure:
     ax_p.set_xlabel(label(var, f"{name}, {e1}"))
     ax_e.set_title("elevation")
     ax_p.set_title("plan")
-    ax_e.legend(fontsize="small")
+    legend(ax_e, fontsize="small")
     for ax in (ax_e, ax_p):
         ax.grid(True, alpha=0.3)
     fig.suptitle(ds.attrs.get("title", ""))
@@ -293,7 +285,7 @@ def tension(data, times=None) -> Figure:
     ax_s.set_xlabel(label(ds.element_s, "unstrained arc length s"))
     ax_s.set_ylabel(label(ds.tension))
     ax_s.set_title("tension along the cable")
-    ax_s.legend(fontsize="small")
+    legend(ax_s, fontsize="small")
     ax_s.grid(True, alpha=0.3)
     if transient:
         ax_t = axes[1]
@@ -305,7 +297,7 @@ def tension(data, times=None) -> Figure:
         ax_t.set_xlabel(label(ds.time, "time"))
         ax_t.set_ylabel(label(ds.reaction, "force at the support |R|"))
         ax_t.set_title("at the supports")
-        ax_t.legend(fontsize="small")
+        legend(ax_t, fontsize="small")
         ax_t.grid(True, alpha=0.3)
     fig.tight_layout()
     return fig
@@ -335,7 +327,7 @@ def modes(data, n: int = 6) -> Figure:
                      fontsize="medium")
         ax.set_ylabel(label(ds["shape"], "shape"))
         ax.grid(True, alpha=0.3)
-    axes[0, 0].legend(fontsize="small", ncol=2)
+    legend(axes[0, 0], fontsize="small", ncol=2)
     axes[-1, 0].set_xlabel(label(x_of, "x") if x_of is not None else label(ds.s, "s"))
     fig.tight_layout()
     return fig
@@ -349,6 +341,10 @@ def _figure(what: str, ds: xr.Dataset, node, times) -> Figure:
     if what == "reactions":
         return reactions(ds)
     return modes(ds)
+
+
+_CAN = {"static": ("profile", "tension"), "modal": ("modes",),  # figures of each kind
+        "transient": ("profile", "history", "spectrum", "tension", "reactions")}
 
 
 def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=None,
@@ -369,24 +365,18 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
                         f"{', '.join(WHAT)}")
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    from catdae.output.reading import step_problem
-
-    for name in names:
-        ds = tree[name].to_dataset()
-        if (why := step_problem(ds)) is not None:
-            raise PlotError(f"step {name[:60]!r}: {why}")
-        kind = ds.attrs.get("kind")
-        can = {"static": ("profile", "tension"), "modal": ("modes",),
-               "transient": ("profile", "history", "spectrum", "tension", "reactions")
-               }.get(kind, ())
-        for w in wanted:
-            if w not in can:
-                continue
-            fig = _figure(w, ds, node, times)
-            path = folder / f"{name}-{w}.png"
-            with deferred():  # a signal waits until the file is complete
-                fig.savefig(path, dpi=120)
-            written.append(path)
+    from catdae.output.reading import step_problem, step_values
+    for group in names:  # a swept step: a figure per value, <step>-sweep<k>-<what>.png
+        if (why := step_problem(tree[group].to_dataset())) is not None:
+            raise PlotError(f"step {group[:60]!r}: {why}")
+        for name, ds in step_values(group, tree[group].to_dataset()):
+            can = _CAN.get(ds.attrs.get("kind"), ())
+            for w in (w for w in wanted if w in can):
+                path = folder / f"{name}-{w}.png"
+                fig = _figure(w, ds, node, times)
+                with deferred():  # a signal waits until the file is complete
+                    fig.savefig(path, dpi=120)
+                written.append(path)
     if "spans" in wanted:  # one figure across the static steps (catdae.output.plot_spans)
         from catdae.output.plot_spans import spans, static_groups
 

@@ -14,13 +14,17 @@ from catdae._xr import xr
 
 
 def static_groups(tree: xr.DataTree, steps=None) -> list[tuple[str, xr.Dataset]]:
-    """(name, dataset) of the static steps with span quantities, in step order."""
-    names = list(tree.children) if not steps else list(steps)
+    """(name, dataset) of the static steps with span quantities, in step order; a swept
+    static step gives one per value (a temperature sweep: a sag-temperature table)."""
+    from catdae.output.reading import step_values
+
+    names = list(tree.children) if not steps else [steps] if isinstance(steps, str) else list(
+        steps)
     out = []
-    for name in names:
-        ds = tree[name].to_dataset()
-        if ds.attrs.get("kind") == "static" and "sag_midspan" in ds:
-            out.append((name, ds))
+    for group in names:
+        full = tree[group].to_dataset()
+        if full.attrs.get("kind") == "static" and "sag_midspan" in full:
+            out.extend(step_values(group, full))
     return out
 
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from catdae._xr import xr
 from catdae.errors import ResultsError
 from catdae.model.mesh import AXES
@@ -39,14 +41,17 @@ def step_problem(ds: xr.Dataset) -> str | None:
         return (f"it has no kind of step (static, modal or transient; found {kind!r})"
                 if kind is not None else "it is not a catdae step (no attribute 'kind')")
     names = set(ds.variables)
+    swept = "sweep" in ds.dims  # a swept step: its values along a leading sweep dimension
     for name, dims in {"node": ("node",), "axis": ("axis",), **_NEEDS[kind]}.items():
         if name not in names:
             return f"a {kind} step without the variable {name!r}"
-        if tuple(ds[name].dims) != dims:
-            return (f"its variable {name!r} has dimensions {tuple(ds[name].dims)}, expected "
-                    f"{dims}")
+        found = tuple(ds[name].dims)
+        if found != dims and not (swept and name not in _LABELS and found == ("sweep", *dims)):
+            return (f"its variable {name!r} has dimensions {found}, expected "
+                    f"{('sweep', *dims) if swept and name not in _LABELS else dims}")
         want_text = name in _LABELS
-        if want_text != (ds[name].dtype.kind in "OUS"):
+        # an empty label (a scene of connectors alone has no element) is stored as numbers
+        if ds[name].size and want_text != (ds[name].dtype.kind in "OUS"):
             return f"its variable {name!r} holds {'numbers' if want_text else 'text'}"
     if list(map(str, ds.axis.values)) != list(AXES):
         return f"its axes are {list(map(str, ds.axis.values))}, expected {list(AXES)}"
@@ -57,6 +62,37 @@ def step_problem(ds: xr.Dataset) -> str | None:
         if missing:
             return f"an element ends at {sorted(missing)[0][:40]!r}, which is not a node"
     return None
+
+
+def step_values(name: str, ds: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
+    """A step group's datasets, each of one state of the scene: the group itself, or for a
+    swept step one per value (``<name>-sweep<k>``, k from 0), with the attributes of that
+    value: those listed in ``sweep_attributes`` (catdae.analysis: they differ between the
+    values) are arrays over the values or their texts joined by " | "."""
+    if "sweep" not in ds.dims:
+        return [(name, ds)]
+    n = ds.sizes["sweep"]
+    listed = ds.attrs.get("sweep_attributes")
+    varying = set(str(listed).split()) if listed is not None else None
+    out = []
+    for k in range(n):
+        one = ds.isel(sweep=k)
+        one.attrs = {key: _value_attr(v, k, n) if varying is None or key in varying else v
+                     for key, v in ds.attrs.items()}
+        value = f"{ds.attrs.get('sweep_field', 'sweep')} = {float(ds.sweep[k]):.6g}"
+        one.attrs["title"] = f"{ds.attrs.get('title', '')} ({name}: {value})".strip()
+        one.attrs["sweep_value"] = value
+        out.append((f"{name}-sweep{k}", one))
+    return out
+
+
+def _value_attr(v, k: int, n: int):
+    """The k-th value's attribute of a swept step's attribute ``v`` (n values)."""
+    if np.ndim(v) == 1 and len(v) == n:
+        return v[k]
+    if isinstance(v, str) and v.count(" | ") == n - 1:
+        return v.split(" | ")[k]
+    return v
 
 
 def read_results_file(path: str | os.PathLike) -> xr.DataTree:

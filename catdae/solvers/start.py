@@ -35,7 +35,8 @@ class ConsistentStart:
         continuous and the free velocities jump by -M_ff⁻¹ M_fs Δv_s. (Keeping v_f instead
         would apply an impulse -M_fs Δv_s to the free dofs; with the consistent catenary mass,
         which amplifies chord motion in slack elements, that impulse grows with the mesh.)
-        With a lumped mass M_fs = 0 and nothing changes.
+        With a lumped mass M_fs = 0 (but for a bar's consistent mass or the water's
+        added mass between a support and a free node) and nothing changes.
         """
         m = self.model
         conf = self.configuration(t0, q0)
@@ -56,7 +57,7 @@ class ConsistentStart:
             self.velocity_jumps.append((float(t0), float(np.abs(dvs).max()),
                                         float(lam2.max())))
         v0 = np.array(v0, float)
-        if np.any(dvs) and not m.mass_model.lumped:
+        if np.any(dvs):  # M_fs: zero with a lumped mass, unless bars or water couple
             full = m.pattern.matrix(mdata)
             v0 -= spla.spsolve(mff, full[self.fidx][:, m.fixed] @ dvs)
         if self.axial is not None:  # the chords of q0 for the strain rates

@@ -56,16 +56,27 @@ def study_step(case: Case, step: str | None = None) -> Step:
     """The step named ``step``; by default the first transient step, else the first modal one,
     else the first static one (catdae.study.quantity)."""
     if step is not None:
-        for s in case.steps:
-            if s.name == step:
-                return s
-        names = ", ".join(repr(s.name) for s in case.steps) or "none"
-        raise StudyError(f"the case has no step named {step!r} (steps: {names})")
+        found = [s for s in case.steps if s.name == step]
+        if not found:
+            names = ", ".join(repr(s.name) for s in case.steps) or "none"
+            raise StudyError(f"the case has no step named {step!r} (steps: {names})")
+        return _not_swept(case, found[0])
     for kind in ("transient", "modal", "static"):
         for s in case.steps:
             if s.kind == kind:
-                return s
+                return _not_swept(case, s)
     raise StudyError("the case has no step to study")
+
+
+def _not_swept(case: Case, step: Step) -> Step:
+    """The study step, refused when it is swept: a study measures one state per run."""
+    if step.sweep is None:
+        return step
+    k = case.steps.index(step)
+    raise StudyError(f"{case.path}: steps[{k}].sweep: the study step {step.name!r} is swept over "
+                     f"{step.sweep.field}; a study measures one state of its step per run: "
+                     "study a copy of the step without its sweep (the value set in the case), "
+                     "or name another step with --step")
 
 
 def settings_grid(case: Case, step: Step, given: Mapping[str, Sequence | None]) -> dict:

@@ -64,3 +64,83 @@ def test_bad_sweeps_are_located(sweep, field, words, tmp_path, capsys):
     assert main(["check", str(f)]) == 2
     err = capsys.readouterr().err
     assert f"{f}: {field}: {words}" in err, err
+
+
+GUY = scene(head={"title": "a guy line", "reference_temperature": 20.0},
+            materials={"guy": {"EA": 5.0e7, "mass": 2.0, "thermal_expansion": 1.2e-5}},
+            nodes={"A": (0.0, 0.0, 0.0), "B": (40.0, 0.0, 60.0)}, supports=("A", "B"),
+            cables='[[cables]]\nname = "g"\nends = ["A", "B"]\nmaterial = "guy"\n'
+                   'length = 72.05\nelements = 4\n')
+
+
+def test_a_temperature_sweep_is_labelled_and_drawn_per_value(tmp_path, capsys):
+    """Each value of a temperature_change sweep carries its own temperature (attributes that
+    differ between values are arrays over them, case-format.md): the printed summary, the
+    group's attributes, and a value's dataset agree with a step run at that temperature
+    alone. The file plots (a figure per value, and the sag-temperature figure across them)
+    and exports (a series per value); an ordinary step beside it too."""
+    from catdae.cli import main
+    from catdae.output.reading import step_values
+
+    values = [-40.0, 0.0, 10.0]
+    text = GUY + step("static", "ref") + step(
+        "static", "sw", sweep={"field": "temperature_change", "values": values}) + step(
+        "static", "hot", temperature_change=10.0)
+    case = tmp_path / "guy.toml"
+    case.write_text(text)
+    out = tmp_path / "guy.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    for v in values:
+        assert f"[sw temperature_change = {v:g}] static at {20 + v:g} deg" in printed, printed
+    tree = catdae.read_results(out)
+    sw = tree["sw"].ds
+    assert np.array_equal(sw.attrs["temperature_change"], values)
+    assert np.array_equal(sw.attrs["temperature"], np.add(values, 20.0))
+    (_, last), hot = step_values("sw", sw)[-1], tree["hot"].ds
+    assert last.attrs["temperature"] == hot.attrs["temperature"] == 30.0
+    assert float(last.cable_end_tension.max()) == pytest.approx(
+        float(hot.cable_end_tension.max()), rel=1e-12)
+    figs = tmp_path / "figs"
+    assert main(["plot", str(out), "-o", str(figs)]) == 0
+    names = {p.name for p in figs.iterdir()}
+    assert {"sw-sweep0-profile.png", "sw-sweep2-tension.png", "ref-profile.png",
+            "spans.png"} <= names, names
+    assert main(["plot", str(out), "-o", str(figs), "--step", "hot"]) == 0
+    vtk = tmp_path / "vtk"
+    assert main(["export", str(out), "--vtk", str(vtk)]) == 0
+    assert {"sw-sweep1.pvd", "ref.pvd", "hot.pvd"} <= {p.name for p in vtk.iterdir()}
+
+
+def test_a_scene_of_connectors_alone_plots_and_exports(tmp_path, capsys):
+    """No cable (the spring and damper scene above): the figures and the VTK series are made,
+    the connectors drawn between their end nodes (``connector_node``)."""
+    import meshio
+
+    from catdae.cli import main
+
+    case = tmp_path / "spring.toml"
+    case.write_text(SPRING + step("static", "st"))
+    out = tmp_path / "spring.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    ds = catdae.read_results(out)["st"].ds
+    assert ds.connector_node.sel(connector="k").values.tolist() == ["G", "N"]
+    assert main(["plot", str(out), "-o", str(tmp_path / "figs"), "--what", "profile"]) == 0
+    assert main(["export", str(out), "--vtk", str(tmp_path / "vtk")]) == 0
+    mesh = meshio.read(tmp_path / "vtk" / "st" / "st_00000.vtu")
+    assert sum(len(b.data) for b in mesh.cells) == 2  # the spring and the damper
+    force = np.concatenate(mesh.cell_data["tension"])
+    assert np.allclose(force, ds.connector_force.values)
+
+
+def test_a_study_of_a_swept_step_is_refused_before_any_run(tmp_path, capsys):
+    from catdae.study.cli import main as study
+
+    case = tmp_path / "swept.toml"
+    case.write_text(SPRING + step("static", "st") + step(
+        "modal", "modes", modes=1, sweep={"field": "dampers.d.coefficient",
+                                          "values": [0.0, 10.0]}))
+    assert study([str(case), "--step", "modes", "-o", str(tmp_path / "s.nc")]) == 2
+    err = capsys.readouterr().err
+    assert f"{case}: steps[1].sweep: the study step 'modes' is swept" in err, err
+    assert not (tmp_path / "s.nc").exists()

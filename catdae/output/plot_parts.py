@@ -1,0 +1,48 @@
+"""Pieces of catdae's figures (catdae.output.plot): axis labels, figures without pyplot,
+legends, and the connectors drawn beside the cables."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from catdae._xr import xr
+
+
+def label(var: xr.DataArray, name: str | None = None) -> str:
+    """'long_name [units]' from the variable's attributes (time: 's')."""
+    text = name or var.attrs.get("long_name", var.name)
+    units = var.attrs.get("units")
+    if units and " since " in str(units).lower():  # CF time: "seconds Since <epoch>"
+        units = str(units)[:str(units).lower().index(" since ")].replace("seconds", "s")
+    return f"{text} [{units}]" if units else str(text)
+
+
+def subplots(*args, figsize, **kwargs):
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(*args, **kwargs)
+
+
+def legend(ax, **kwargs) -> None:
+    """The axes' legend, where something drawn has a label (a scene of connectors alone has
+    no cable to name)."""
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(**kwargs)
+
+
+def draw_connectors(ax_e, ax_p, ds: xr.Dataset, x: xr.DataArray, R, t) -> None:
+    """Springs, dampers and bars as dashed lines between their end nodes (``connector_node``),
+    in elevation and plan, at the positions ``x`` (node, axis) of time t (None: static)."""
+    if "connector_node" not in ds.coords or not ds.sizes.get("connector"):
+        return
+    for k, (name, ends) in enumerate(zip(ds.connector.values, ds.connector_node.values,
+                                         strict=True)):
+        pts = np.asarray(x.sel(node=[str(e) for e in ends]).transpose("node", "axis").values,
+                         float)
+        if R is not None:
+            pts = pts @ R.T  # (horizontal e1, e2, height along up)
+        tag = ("connectors" if t is None else f"connectors, t = {t:.4g} s") if k == 0 else None
+        ax_e.plot(pts[:, 0], pts[:, 2], ls="--", marker="o", ms=3, lw=1.2, color="0.35",
+                  label=tag, gid=f"{name}|{t}")
+        ax_p.plot(pts[:, 0], pts[:, 1], ls="--", marker="o", ms=3, lw=1.2, color="0.35",
+                  gid=f"{name}|{t}")
