@@ -3,11 +3,12 @@ envelopes of a transient over its output times (docs/case-format.md, "What an en
 
 Static groups get, per cable, the span quantities of :func:`catdae.model.span.span_quantities`
 and ``tension_percent_rated``. Transient groups get per node the extremes of ``reaction`` and
-``displacement`` with their times, per cable ``tension_percent_rated`` (largest over the
-outputs) and, when the step names a ``jump_reference`` static step, the largest rise of each
-cable above its position there (``jump_height``, an ice-shedding jump). Envelopes are taken
-over the stored output times: a peak between two outputs is missed by at most what the motion
-does in one output interval.
+``displacement`` with their times, per cable ``tension_percent_rated`` (of the step's
+``tension_max`` envelope, which sees peaks between outputs) and, when the step names a
+``jump_reference`` static step, the largest rise of each cable above its position there
+(``jump_height``, an ice-shedding jump). The envelopes of reactions and displacements are
+taken over the stored output times: a peak between two outputs is missed by at most what the
+motion does in one output interval.
 """
 
 from __future__ import annotations
@@ -96,8 +97,8 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
                   up: np.ndarray | None = None) -> xr.Dataset:
     """The transient group with its envelopes over the output times: ``reaction_max``,
     ``reaction_min`` (node, axis) and their ``_time``, the same for ``displacement``; per
-    cable ``tension_percent_rated`` when a material has a rated strength; and with
-    ``reference`` (the named static step's group) ``jump_height``, ``jump_time`` and
+    cable ``tension_percent_rated`` (of ``tension_max``) when a material has a rated strength;
+    and with ``reference`` (the named static step's group) ``jump_height``, ``jump_time`` and
     ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z)."""
     if ds.sizes.get("time", 0) == 0:
         return ds
@@ -108,11 +109,13 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
     cables = list(dict.fromkeys(str(c) for c in ds.element_cable.values))
     rated = rated_strengths(case, cables)
     if np.isfinite(rated).any():
-        t_max = [float(ds.tension.values[:, ds.element_cable.values == c].max()) for c in cables]
+        # the envelope of every accepted step (a peak between outputs counts), else the outputs
+        top = (ds.tension_max if "tension_max" in ds else ds.tension.max("time")).values
+        t_max = [float(top[ds.element_cable.values == c].max()) for c in cables]
         data["tension_percent_rated"] = _cable_var(
             100.0 * np.array(t_max) / rated, "percent",
-            "largest tension along the cable over the output times as a percentage of the "
-            "material's rated_strength")
+            "largest tension along the cable during the step (its tension_max envelope) as a "
+            "percentage of the material's rated_strength")
     out = ds.assign_coords(cable=xr.Variable("cable", np.array(cables, dtype=object),
                                              {"long_name": "cable name"})).assign(data)
     if reference is not None:

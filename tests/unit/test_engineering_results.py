@@ -60,7 +60,8 @@ def test_envelopes_are_the_extremes_of_the_stored_histories(kicked):
 
 def test_tension_against_the_rated_strength_and_the_jump(kicked):
     ds = kicked["kicked"].ds
-    t_max = float(ds.tension.max())
+    t_max = float(ds.tension_max.max())  # the envelope of every step: peaks between outputs
+    assert t_max >= float(ds.tension.max())
     assert float(ds.tension_percent_rated.sel(cable="c")) == pytest.approx(
         100 * t_max / 2000.0, rel=1e-14)
     rest = kicked["rest"].ds
