@@ -124,7 +124,12 @@ class Builder(CablesPass, ConnectorsPass, StepsPass, SweepPass, TimePass, FluidP
         supports = self.supports(top.supports, nodes)
         self.gravity_supports(supports)
         cables = self.cables(top.cables, materials, nodes)
-        self.cable_ends |= connector_ends(top)  # what a connector holds is held
+        ends = connector_ends(top)
+        self.cable_ends |= ends  # what a connector holds is held
+        if any(e not in self.node_names and cable_of(e) not in self.cable_names for e in ends):
+            # a connector's end misspelt (reported with its fix): the node it meant is not
+            # "held by nothing", nor what is placed on it
+            self.cable_ends |= self.node_names
         held = top.cables or top.springs or top.dampers or top.bars
         if not held and "cables" not in bad:
             self.problem(("cables",), "no cable at all: add at least one [[cables]] entry "

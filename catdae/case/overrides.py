@@ -5,6 +5,7 @@ mesh."""
 
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import replace
 
@@ -69,7 +70,7 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
                         f"{item.name!r} sits on mesh node {item.node!r} of cable {cable!r}, "
                         f"whose length is found by form-finding; with {elements} elements "
                         "it would fall between mesh nodes: use a multiple of "
-                        f"{c.elements} elements"))])
+                        f"{c.elements // math.gcd(int(k), c.elements)} elements"))])
                 return replace(item, node=mesh_node(cable, k_new))
             return replace(item, node=None, cable=cable, s=int(k) * c.length / c.elements)
 
@@ -85,7 +86,8 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
                 raise CaseError(self.path, [("elements", (
                     f"{what} ends on mesh node {ref!r}, which with {elements} elements would "
                     f"fall between mesh nodes: use a multiple of "
-                    f"{by_name[cable].elements} elements"))])
+                    f"{by_name[cable].elements // math.gcd(int(k), by_name[cable].elements)} "
+                    "elements"))])
             return mesh_node(cable, k_new)
 
         connectors = {section: tuple(

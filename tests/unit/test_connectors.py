@@ -184,4 +184,24 @@ def test_more_elements_keep_a_connector_on_its_mesh_node(tmp_path):
     assert [d.ends for d in finer.dampers] == [("c.4", "G")]
     assert [b.ends for b in finer.bars] == [("c.6", "H")]
     with pytest.raises(CaseError, match="use a multiple of 4 elements"):
-        case.with_overrides(elements=6)
+        case.with_overrides(elements=6)  # c.3 of 4
+    midspan = _toml(bad(spring("k", ["c.2", "G"], 1.0)))  # c.2 of 4: any even count
+    assert [k.ends for k in midspan.with_overrides(elements=6).springs] == [("c.3", "G")]
+    with pytest.raises(CaseError, match="use a multiple of 2 elements"):
+        midspan.with_overrides(elements=3)
+
+
+def test_a_misspelt_connector_end_is_the_only_message(tmp_path, capsys):
+    """The node the spring was meant to hold (with a point mass on it) is not reported as held
+    by nothing: those would follow from the misspelling, which is reported with its fix."""
+    from catdae.cli import main
+
+    f = tmp_path / "bad.toml"
+    f.write_text(cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
+                             nodes={"m": (5.0, 0.0, -2.0)}, supports=("A", "B"),
+                             extra=spring("k", ["c.2", "mm"], 1.0e3)
+                             + point_mass("bob", 10.0, node="m"), steps=static_step("st")))
+    assert main(["check", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert f"{f}: springs[0].ends[1]: unknown node 'mm'; did you mean 'm'?" in err, err
+    assert "nothing" not in err, err
