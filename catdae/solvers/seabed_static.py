@@ -21,6 +21,7 @@ from catdae.element import grounded as g
 from catdae.errors import ConvergenceError
 from catdae.model.assembly import Model
 from catdae.model.seabed import ContactModel, GroundedModel, SeabedContact
+from catdae.solvers.line_start import check_not_slack, line_paths, place_line
 from catdae.solvers.static import StaticSolution, solve_static
 
 
@@ -37,7 +38,9 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
     fscale = max(float((model.mesh.w * model.mesh.L0).sum()), 1e-300)
     fixed_z = model.fixed_mask[:, 2]
     support_on = fixed_z & (np.abs(X[:, 2] - zb) <= ztol)
-    start = grounded_start(model, X, support_on)
+    for path, fwd in line_paths(model, support_on, t):
+        check_not_slack(model, X, path, fwd)
+    start = grounded_start(model, X, support_on, t)
     try:
         return _active_set(model, zb, start.copy(), h0, t, load_steps, max_rounds, ztol, fscale,
                            support_on)
@@ -161,9 +164,12 @@ def seabed_push(gm: GroundedModel, state, X: np.ndarray, t: float) -> np.ndarray
     return r.reshape(-1, 3)[:, 2]
 
 
-def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray) -> np.ndarray:
+def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray, t: float = 0.0
+                   ) -> np.ndarray:
     """Nodes of every cable with exactly one end supported on the seabed (uniform w and EA,
-    no loads inside) placed on the grounded catenary of the whole cable; others unchanged."""
+    no loads inside) placed on the grounded catenary of the whole cable, and those of every
+    line of several cables in series from an anchor on the seabed to a support above it
+    (catdae.solvers.line_start) on the line's equilibrium; others unchanged."""
     mesh = model.mesh
     el = model.elements
     X = X.copy()
@@ -192,6 +198,9 @@ def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray) -> np.nd
         g.position_batch(h[None], np.array([w]), np.array([ea]), np.array([l0]),
                          np.array([mode]), s, out)
         X[inner] = X[a] + out[0]
+    for path, fwd in line_paths(model, on_support, t):
+        if np.unique(mesh.cable_of_element[path]).size > 1:
+            place_line(model, X, path, fwd)
     return X
 
 

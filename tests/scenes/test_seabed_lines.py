@@ -1,0 +1,109 @@
+"""Mooring lines on a rigid, frictionless seabed beyond the single uniform chain
+(docs/theory.md §17.4, §17.6): a chain-wire-chain line whose touchdown falls in the wire, a line
+too long to be taut, a spread mooring with load steps, and the touchdown point's definition.
+
+Independent references: ``reference.grounded_line`` (the segments' elastic catenaries shot
+down from the fairlead by nested root solves, no catdae code), ``reference.grounded_catenary``
+and MoorPy's ``Catenary.catenary``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import catdae
+from catdae.case import load_case
+from catdae.errors import CatdaeError
+
+from reference import grounded_line
+from scene_toml import cable, scene, section
+
+RHO, G = 1025.0, 9.81
+CHAIN = {"EA": 1.674e9, "mass": 390.0, "diameter": 0.252}
+WIRE = {"EA": 6.0e8, "mass": 40.0, "diameter": 0.1}
+
+
+def w_sub(mat) -> float:
+    """Submerged weight per metre (the default water, density 1025 kg/m³, g = 9.81)."""
+    return (mat["mass"] - RHO * math.pi * mat["diameter"] ** 2 / 4.0) * G
+
+
+def run_static(text: str):
+    tree = catdae.run(load_case(text), progress=False)
+    return tree[next(iter(tree.children))].to_dataset()
+
+
+def mseg_toml(j1, j2, *, reverse: bool = False) -> str:
+    """300 m chain from the anchor (x = 700 m on the seabed, 200 m down), 420 m wire, 60 m
+    chain to the fairlead at the origin; the junctions j1, j2 start where given."""
+    def ends(a, b):
+        return (b, a) if reverse else (a, b)
+    return scene(head={"title": "chain-wire-chain"},
+                 materials={"chain": CHAIN, "wire": WIRE},
+                 nodes={"anchor": (700.0, 0.0, -200.0), "j1": j1, "j2": j2,
+                        "fairlead": (0.0, 0.0, 0.0)},
+                 supports=("anchor", "fairlead"),
+                 cables=[cable("bottom", ends("anchor", "j1"), "chain", 300.0, 8),
+                         cable("mid", ends("j1", "j2"), "wire", 420.0, 10),
+                         cable("top", ends("j2", "fairlead"), "chain", 60.0, 4)],
+                 extra=section("water", depth=200.0) + section("seabed"))
+
+
+@pytest.mark.parametrize("j1, j2, reverse", [
+    ((399.0, 0.0, -200.0), (40.0, 0.0, -45.0), False),  # the tester's failing start
+    ((380.0, 0.0, -200.0), (40.0, 0.0, -45.0), False),
+    ((401.0, 0.0, -200.0), (40.0, 0.0, -45.0), False),
+    ((410.0, 0.0, -197.0), (55.0, 0.0, -50.0), False),  # junction off the seabed
+    ((300.0, 0.0, -150.0), (30.0, 0.0, -50.0), True),  # far off, cables written reversed
+])
+def test_chain_wire_chain_line_is_the_shooting_solution(j1, j2, reverse):
+    """Touchdown in the wire, the junction j1 on the seabed: from junction starts 20 m short,
+    1 m short, 1 m long of the answer or far off it, the equilibrium is the shooting solution's
+    (H = 90 096 N, 395.21 m lying) to 1e-7 relative, and so are the junctions' positions and
+    the touchdown point."""
+    ref = grounded_line(700.0, 200.0, [(60.0, CHAIN["EA"], w_sub(CHAIN)),
+                                       (420.0, WIRE["EA"], w_sub(WIRE)),
+                                       (300.0, CHAIN["EA"], w_sub(CHAIN))])
+    ds = run_static(mseg_toml(j1, j2, reverse=reverse))
+    H, V = ref["H"], ref["V"]
+    assert H == pytest.approx(90095.6, rel=1e-6)  # the tester's figure
+    fair = ds.reaction.sel(node="fairlead").values
+    anch = ds.reaction.sel(node="anchor").values
+    assert fair == pytest.approx([-H, 0.0, V], rel=1e-7, abs=1e-9 * H)
+    assert anch == pytest.approx([H, 0.0, 0.0], rel=1e-7, abs=1e-9 * H)
+    assert float(ds.seabed_length.sum()) == pytest.approx(ref["lying_length"], rel=1e-7)
+    (x2, d2), (x1, d1), _ = ref["joints"]
+    assert ds.position.sel(node="j2").values == pytest.approx([x2, 0.0, -d2], abs=1e-6)
+    assert ds.position.sel(node="j1").values == pytest.approx([x1, 0.0, -d1], abs=1e-6)
+    in_wire = ref["lying_length"] - 300.0
+    td = ds.touchdown.sel(cable="mid").values
+    assert td == pytest.approx([x1 - in_wire * (1.0 + H / WIRE["EA"]), 0.0, -200.0], abs=1e-6)
+
+
+def test_line_longer_than_span_plus_depth_is_refused():
+    """2200 m of chain from an anchor 1400 m out to a fairlead 600 m up: H = 0 (MoorPy:
+    V = w depth at the fairlead, the rest on the seabed), with 200 m to spare lying slack
+    anywhere on a frictionless seabed: no unique equilibrium. The step is refused before any
+    Newton iteration with the cable, its length, and span + height in the message."""
+    catenary = pytest.importorskip("moorpy.Catenary").catenary
+    w = w_sub(CHAIN)
+    fa_h, fa_v, fb_h, fb_v, info = catenary(1400.0, 600.0, 2200.0, CHAIN["EA"], w, CB=0.0)
+    assert abs(fb_h) <= 1e-6 * w * 600.0  # MoorPy: no horizontal tension
+    text = scene(materials={"m": CHAIN}, nodes={"anchor": (1400.0, 0.0, -600.0),
+                                               "fairlead": (0.0, 0.0, 0.0)},
+                 supports=("anchor", "fairlead"),
+                 cables=cable("line", ("anchor", "fairlead"), "m", 2200.0, 15),
+                 extra=section("water", depth=600.0) + section("seabed"))
+    with pytest.raises(CatdaeError) as err:
+        run_static(text)
+    msg = str(err.value)
+    for part in ("cable 'line'", "2200 m", "1400 m + 600 m = 2000 m", "cables.length"):
+        assert part in msg, msg
+    assert "Newton" not in msg
+    # a line of 1990 m (10 m to spare below span + depth) is taut and solved
+    ds = run_static(text.replace("length = 2200.0", "length = 1990.0"))
+    assert float(-ds.reaction.sel(node="fairlead").values[0]) > 0.0
+    assert np.isfinite(ds.position.values).all()
