@@ -59,8 +59,8 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
     penalty = ContactModel(model, SeabedContact.of_model(model, stiffness=k,
                                                          width=np.ones(mesh.n_elements)))
     pre = solve_static(penalty, X, None, t=t, load_steps=load_steps)
-    return _active_set(model, zb, pre.X, None, t, load_steps, max_rounds, ztol, fscale,
-                       support_on)
+    # pre is the equilibrium at the full loads: the active set starts there, without a ramp
+    return _active_set(model, zb, pre.X, None, t, 1, max_rounds, ztol, fscale, support_on)
 
 
 def _current_ramp(model, zb, X, args):
@@ -106,6 +106,7 @@ def _stage(model, zb, sol, contact, args):
     last = np.zeros_like(contact)
     last[conn[a & ~b, 0]] = True
     last[conn[b & ~a, 1]] = True
+    args = (args[0], 1, *args[2:])  # from the last stage's equilibrium at the full loads
     for trial in (contact, grow, contact & ~last):
         try:
             return _active_set(model, zb, sol.X.copy(), sol.state.h, *args, contact=trial)
@@ -126,6 +127,10 @@ def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, suppo
         gm = GroundedModel(model, contact, contact | support_on, zb)
         sol = solve_static(gm, X, h, t=t, load_steps=load_steps)
         X, h = sol.X, sol.state.h
+        # the next set starts from this one's equilibrium at the full loads: ramping the loads
+        # again from a fraction would start a fixed set, chosen for the full loads, far from
+        # its equilibrium at that fraction (where the set is not the right one)
+        load_steps = 1
         rz = seabed_push(gm, sol.state, X, t)  # what the seabed must push up with
         below = ~fixed_z & ~contact & (X[:, 2] < zb - ztol)
         pulling = contact & (rz < -1e-9 * fscale)

@@ -107,3 +107,56 @@ def test_line_longer_than_span_plus_depth_is_refused():
     ds = run_static(text.replace("length = 2200.0", "length = 1990.0"))
     assert float(-ds.reaction.sel(node="fairlead").values[0]) > 0.0
     assert np.isfinite(ds.position.values).all()
+
+
+def spread_toml(load_steps: int) -> str:
+    """Three 760 m chains from anchors on the seabed 700 m around a free shared node C, which
+    a buoy pulls with (500 kN, 0, 3000 kN)."""
+    anchors = {f"a{k}": (700.0 * math.cos(2 * math.pi * k / 3),
+                         700.0 * math.sin(2 * math.pi * k / 3), -200.0) for k in range(3)}
+    return scene(materials={"chain": CHAIN}, nodes={**anchors, "C": (0.0, 0.0, -20.0)},
+                 supports=tuple(anchors),
+                 cables=[cable(f"l{k}", (f"a{k}", "C"), "chain", 760.0, 10) for k in range(3)],
+                 extra=section("water", depth=200.0) + section("seabed")
+                 + "[[loads]]\nname = \"buoy\"\nnode = \"C\"\nforce = [500000.0, 0.0, 3000000.0]\n",
+                 steps=f"[[steps]]\nkind = \"static\"\nname = \"s\"\nload_steps = {load_steps}\n")
+
+
+@pytest.mark.parametrize("load_steps", [1, 2, 4])
+def test_spread_mooring_with_load_steps(load_steps):
+    """The shared node's equilibrium, with each line the closed-form grounded catenary
+    (``reference.grounded_catenary``) and the buoy's force, found by fsolve on C's position:
+    catdae's C, fairlead tensions and lying lengths agree to 1e-6 relative with 1, 2 and 4
+    load steps. (With load steps the contact-set rounds after the first used to ramp the load
+    again from a fraction, from a configuration and set of the full load, and failed.)"""
+    from scipy.optimize import fsolve
+
+    from reference import grounded_catenary
+
+    w = w_sub(CHAIN)
+    anchors = np.array([[700.0 * math.cos(2 * math.pi * k / 3),
+                         700.0 * math.sin(2 * math.pi * k / 3), -200.0] for k in range(3)])
+    force = np.array([5.0e5, 0.0, 3.0e6])
+
+    def lines(c):
+        out = []
+        for a in anchors:
+            d = a[:2] - c[:2]
+            span = float(np.hypot(*d))
+            out.append((grounded_catenary(span, c[2] + 200.0, 760.0, CHAIN["EA"], w), d / span))
+        return out
+
+    def residual(c):
+        f = force.copy()
+        for ref, e in lines(c):
+            f += [ref["H"] * e[0], ref["H"] * e[1], -ref["V"]]
+        return f / 1e6
+
+    c = fsolve(residual, [13.0, 0.0, -42.0], xtol=1e-12)
+    ds = run_static(spread_toml(load_steps))
+    assert ds.position.sel(node="C").values == pytest.approx(c, abs=1e-6 * 700.0)
+    for k, (ref, _) in enumerate(lines(c)):
+        anch = np.linalg.norm(ds.reaction.sel(node=f"a{k}").values)
+        assert anch == pytest.approx(ref["anchor_tension"], rel=1e-6)
+        assert float(ds.seabed_length.sel(cable=f"l{k}")) == pytest.approx(ref["lying_length"],
+                                                                          rel=1e-6)
