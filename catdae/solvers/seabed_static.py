@@ -252,9 +252,11 @@ def _check_slack_resting(gm: GroundedModel, sol, fscale: float) -> None:
 
 
 def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str, np.ndarray]:
-    """Per cable: unstrained length resting on the seabed, and the touchdown point (where the
-    line leaves the seabed for the suspended part; NaN when it does not touch or does not
-    leave)."""
+    """Per cable: unstrained length resting on the seabed, and the touchdown point: where the
+    suspended part that reaches the cable's upper end (the higher of its two ends, its second
+    end when they are level) leaves the seabed, i.e. the last contact point seen from the upper
+    end, whatever the cable's end order; NaN when the cable does not touch, or when its upper
+    end itself rests on the seabed (it does not leave it)."""
     mesh = gm.mesh
     nc = len(mesh.cable_names)
     lying = gm.elements.lying_length(h)
@@ -265,14 +267,18 @@ def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str,
         els = np.flatnonzero(mesh.cable_of_element == ci)
         if length[ci] <= 0.0:
             continue
-        for e in els:
-            if gm.mode[e] in (g.AT_I, g.AT_J):
+        from_last = X[mesh.conn[els[-1], 1], 2] >= X[mesh.conn[els[0], 0], 2]
+        walk = els[::-1] if from_last else els
+        leaves = g.AT_I if from_last else g.AT_J  # the grounded mode whose free end faces up
+        for e in walk:
+            if gm.mode[e] == g.FREE:
+                continue
+            if gm.mode[e] == leaves:
                 s = np.zeros((mesh.n_elements, 1))
                 s[e, 0] = np.clip(-h[e, 2] / el.w[e], 0.0, el.L0[e])
                 touchdown[ci] = X[mesh.conn[e, 0]] + gm.elements.position(h, s)[e, 0]
-                break
+            break  # else the upper end rests on the seabed: the cable does not leave it
     return {"seabed_length": length, "touchdown": touchdown}
-
 
 
 def solve_static_on_seabed(model: Model, X, h0=None, t: float = 0.0, load_steps: int = 1):

@@ -1,5 +1,5 @@
 """Mooring lines on a rigid, frictionless seabed beyond the single uniform chain
-(docs/theory.md §17.4, §17.6): a chain-wire-chain line whose touchdown falls in the wire, a line
+(docs/theory.md §17.4): a chain-wire-chain line whose touchdown falls in the wire, a line
 too long to be taut, a spread mooring with load steps, and the touchdown point's definition.
 
 Independent references: ``reference.grounded_line`` (the segments' elastic catenaries shot
@@ -160,3 +160,61 @@ def test_spread_mooring_with_load_steps(load_steps):
         assert anch == pytest.approx(ref["anchor_tension"], rel=1e-6)
         assert float(ds.seabed_length.sel(cable=f"l{k}")) == pytest.approx(ref["lying_length"],
                                                                           rel=1e-6)
+
+
+def lifted_anchor_reference(span, height, lift, L0, EA, w):
+    """A chain from an anchor ``lift`` above a frictionless seabed (``height`` below the
+    fairlead, ``span`` away) that touches down between them: one H, a catenary from the
+    seabed up to each end (suspended lengths l_f, l_a from the rises), the rest lying,
+    stretched by H/EA. H by ``brentq`` on the span. Returns H and the touchdown's horizontal
+    distance from the fairlead (where the part reaching the fairlead leaves the seabed)."""
+    from scipy.optimize import brentq
+
+    def rise(H, ls):
+        a = w * ls / H
+        return (H / w) * (math.sqrt(1.0 + a * a) - 1.0) + w * ls * ls / (2.0 * EA)
+
+    def run(H, ls):
+        return (H / w) * math.asinh(w * ls / H) + H * ls / EA
+
+    def parts(H):
+        lf = brentq(lambda s: rise(H, s) - height, 0.0, L0, xtol=1e-13, rtol=1e-15)
+        la = brentq(lambda s: rise(H, s) - lift, 0.0, L0, xtol=1e-13, rtol=1e-15)
+        return lf, la
+
+    def span_of(H):
+        lf, la = parts(H)
+        return (L0 - lf - la) * (1.0 + H / EA) + run(H, lf) + run(H, la) - span
+
+    H = brentq(span_of, 1e4, 3e6, xtol=1e-9, rtol=1e-15)  # the suspended parts fit at 3 MN
+    return H, run(H, parts(H)[0])
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+@pytest.mark.parametrize("lift", [0.0, 0.1, 4.0])
+def test_touchdown_is_where_the_line_leaves_the_seabed_for_the_fairlead(lift, reverse):
+    """A 760 m chain, anchor 700 m out and ``lift`` above the seabed, 200 m down: the line
+    touches down near the anchor too when the anchor is lifted, but ``touchdown`` is where it
+    leaves the seabed for the fairlead (the higher end) with either end order: the reference
+    to 1e-6 m (it used to report the touchdown near the anchor, 690.8 m, at a 0.1 m lift).
+    On contact springs (node resolution) it is the last node in contact from the fairlead,
+    the same node with either end order."""
+    H, x_td = lifted_anchor_reference(700.0, 200.0, lift, 760.0, CHAIN["EA"], w_sub(CHAIN))
+    ends = ("fairlead", "anchor") if reverse else ("anchor", "fairlead")
+
+    def text(seabed):
+        return scene(materials={"m": CHAIN}, nodes={"anchor": (700.0, 0.0, -200.0 + lift),
+                                                   "fairlead": (0.0, 0.0, 0.0)},
+                     supports=("anchor", "fairlead"), cables=cable("line", ends, "m", 760.0, 10),
+                     extra=section("water", depth=200.0) + seabed)
+
+    ds = run_static(text(section("seabed", z=-200.0)))
+    assert float(-ds.reaction.sel(node="fairlead").values[0]) == pytest.approx(H, rel=1e-7)
+    td = ds.touchdown.sel(cable="line").values
+    assert td == pytest.approx([x_td, 0.0, -200.0], abs=1e-6)
+    springs = run_static(text(section("seabed", z=-200.0, stiffness=3.0e6)))
+    node = springs.touchdown.sel(cable="line").values
+    pos = springs.position.values
+    lying = pos[pos[:, 2] < -200.0]  # the nodes in contact
+    assert node[0] == pytest.approx(lying[:, 0].min(), abs=1e-9)  # the one nearest the fairlead
+    assert abs(node[0] - x_td) < 76.0  # within an element of the exact touchdown
