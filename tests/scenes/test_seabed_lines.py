@@ -218,3 +218,28 @@ def test_touchdown_is_where_the_line_leaves_the_seabed_for_the_fairlead(lift, re
     lying = pos[pos[:, 2] < -200.0]  # the nodes in contact
     assert node[0] == pytest.approx(lying[:, 0].min(), abs=1e-9)  # the one nearest the fairlead
     assert abs(node[0] - x_td) < 76.0  # within an element of the exact touchdown
+
+
+def test_failed_static_names_the_node_with_the_largest_residual():
+    """A static solve that cannot finish (one Newton iteration allowed per load increment)
+    says where the out-of-balance force is largest: a node of the cable, its axis and size."""
+    import re
+
+    from catdae.errors import ConvergenceError
+    from catdae.model.assembly import Model
+    from catdae.model.mesh import build_mesh
+    from catdae.solvers.static import solve_static
+
+    case = load_case(scene(materials={"m": CHAIN}, nodes={"A": (0.0, 0.0, 0.0),
+                                                         "B": (300.0, 0.0, 0.0)},
+                           cables=cable("c", ("A", "B"), "m", 320.0, 6),
+                           extra="[[loads]]\nname = \"p\"\nnode = \"c.3\"\n"
+                                 "force = [0.0, 0.0, -2000000.0]\n"))
+    mesh = build_mesh(case)
+    model = Model(case, mesh, set())
+    with pytest.raises(ConvergenceError) as err:
+        solve_static(model, mesh.X0, max_iter=1)
+    found = re.search(r"largest at node '([^']+)', ([xyz]): ([0-9.e+]+) N", str(err.value))
+    assert found, str(err.value)
+    assert found.group(1) in mesh.node_names and found.group(1) not in ("A", "B")
+    assert float(found.group(3)) > 0.0
