@@ -424,6 +424,54 @@ def grounded_catenary(span: float, height: float, L0: float, EA: float, w: float
             "fairlead_tension": math.hypot(H, V), "anchor_tension": H}
 
 
+def grounded_line(span: float, height: float, segments) -> dict:
+    """A mooring line of several uniform segments in series, ``segments`` = [(L0, EA, w), ...]
+    from the fairlead down to the anchor on a frictionless seabed ``span`` away horizontally
+    and ``height`` below the fairlead; shot down from the fairlead.
+
+    With the fairlead's forces (H, V), a segment hanging from the vertical tension V_top has
+    V_bot = V_top - w L0 at its lower end; while V_bot >= 0 it is an elastic catenary
+    (Irvine: dx = (H/w)(asinh(V_top/H) - asinh(V_bot/H)) + H L0/EA, dz = (H/w)(sqrt(1 +
+    (V_top/H)^2) - sqrt(1 + (V_bot/H)^2)) + (V_top^2 - V_bot^2)/(2 EA w)); otherwise it
+    touches down after l_s = V_top/w and the rest lies flat, stretched by H/EA, as does every
+    segment below. Unknowns H and V by nested ``brentq``: V from the height at given H, H from
+    the span. Returns H, V, the lying length and the joints' (dx, dz) from the fairlead
+    (positive away from it and downwards), the anchor last.
+    """
+
+    def shoot(H, V):
+        x = z = lying = 0.0
+        joints = []
+        for L0, EA, w in segments:
+            lo = V - w * L0
+            if lo >= 0.0:
+                x += (H / w) * (math.asinh(V / H) - math.asinh(lo / H)) + H * L0 / EA
+                z += ((H / w) * (math.hypot(1.0, V / H) - math.hypot(1.0, lo / H))
+                      + (V * V - lo * lo) / (2.0 * EA * w))
+                V = lo
+            else:
+                ls = V / w
+                x += ((H / w) * math.asinh(V / H) + H * ls / EA
+                      + (L0 - ls) * (1.0 + H / EA))
+                z += (H / w) * (math.hypot(1.0, V / H) - 1.0) + V * V / (2.0 * EA * w)
+                lying += L0 - ls
+                V = 0.0
+            joints.append((x, z))
+        return x, z, lying, joints
+
+    weight = sum(L0 * w for L0, _, w in segments)
+
+    def v_of(H):
+        return brentq(lambda V: shoot(H, V)[1] - height, 0.0, 4.0 * weight, xtol=1e-300,
+                      rtol=_RTOL, maxiter=500)
+
+    H = brentq(lambda H: shoot(H, v_of(H))[0] - span, 1e-6 * weight, 10.0 * weight,
+               xtol=1e-300, rtol=_RTOL, maxiter=500)
+    V = v_of(H)
+    _, _, lying, joints = shoot(H, V)
+    return {"H": H, "V": V, "lying_length": lying, "joints": joints}
+
+
 def string_with_damper(a_over_l: float, eta: float, mode: int = 1) -> complex:
     """The exact eigenvalue γ L (γ = s / c_w, s the Laplace variable) of a taut string of
     length L with a viscous damper at distance a from one end (Krenk 2000, J. Appl. Mech.

@@ -328,7 +328,8 @@ class ContactModel(Model):
     def summary(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Per cable, at node resolution: unstrained length resting on the seabed (elements
         with both nodes in contact, half of those with one) and the touchdown point (the last
-        node in contact before the cable leaves the seabed, from its first end)."""
+        node in contact seen from the cable's upper end, where the suspended part that reaches
+        it leaves the seabed; catdae.solvers.seabed_static.seabed_summary)."""
         mesh = self.mesh
         nc = len(mesh.cable_names)
         on = np.zeros(mesh.n_nodes, bool)
@@ -339,9 +340,12 @@ class ContactModel(Model):
         touchdown = np.full((nc, 3), np.nan)
         for ci in range(nc):
             els = np.flatnonzero(mesh.cable_of_element == ci)
-            for e in els:
+            first, last = mesh.conn[els[0], 0], mesh.conn[els[-1], 1]
+            walk = els[::-1] if X[last, 2] >= X[first, 2] else els
+            for e in walk:
                 a, b = mesh.conn[e]
-                if on[a] != on[b] and length[ci] > 0:
-                    touchdown[ci] = X[a] if on[a] else X[b]
+                if on[a] or on[b]:  # the first contact from the upper end (none: it rests)
+                    if on[a] != on[b] and length[ci] > 0:
+                        touchdown[ci] = X[a] if on[a] else X[b]
                     break
         return {"seabed_length": length, "touchdown": touchdown}

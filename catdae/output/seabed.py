@@ -24,7 +24,8 @@ def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Data
     """A transient group with ``seabed_length``(time, cable) and ``touchdown``(time, cable,
     axis) at node resolution, from the node positions: nodes at or below the seabed are in
     contact; an element counts whole with both nodes in contact, half with one; the touchdown
-    is the last node in contact before the cable leaves the seabed, from its first end."""
+    is the last node in contact seen from the cable's upper end (the higher end at that time;
+    NaN when that end itself rests on the seabed), as in the static groups."""
     if "position" not in ds or "time" not in ds.dims:
         return ds
     z = ds.position.sel(axis="z").transpose("time", "node").values  # (nt, n_nodes)
@@ -41,10 +42,13 @@ def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Data
     for c in range(nc):
         els = np.flatnonzero(mesh.cable_of_element == c)
         a, b = mesh.conn[els, 0], mesh.conn[els, 1]
-        leave = on[:, a] != on[:, b]  # (nt, elements of the cable): one end on, one off
-        first = leave.argmax(axis=1)  # the first such element of each time
+        touch = on[:, a] | on[:, b]  # (nt, elements of the cable): a node in contact
+        up_last = z[:, order][:, b[-1]] >= z[:, order][:, a[0]]  # walk from the upper end
+        k = touch.shape[1]
+        first = np.where(up_last, k - 1 - touch[:, ::-1].argmax(axis=1), touch.argmax(axis=1))
         node = np.where(on[rows, a[first]], a[first], b[first])  # its end in contact
-        has = leave.any(axis=1) & (length[:, c] > 0.0)
+        has = (touch.any(axis=1) & (on[rows, a[first]] != on[rows, b[first]])
+               & (length[:, c] > 0.0))
         td[has, c] = pos[rows[has], node[has]]
     if "cable" not in ds.coords:
         ds = ds.assign_coords(cable=label("cable", mesh.cable_names, "cable name"))

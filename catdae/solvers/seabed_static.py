@@ -21,6 +21,7 @@ from catdae.element import grounded as g
 from catdae.errors import ConvergenceError
 from catdae.model.assembly import Model
 from catdae.model.seabed import ContactModel, GroundedModel, SeabedContact
+from catdae.solvers.line_start import check_not_slack, line_paths, place_line
 from catdae.solvers.static import StaticSolution, solve_static
 
 
@@ -37,7 +38,9 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
     fscale = max(float((model.mesh.w * model.mesh.L0).sum()), 1e-300)
     fixed_z = model.fixed_mask[:, 2]
     support_on = fixed_z & (np.abs(X[:, 2] - zb) <= ztol)
-    start = grounded_start(model, X, support_on)
+    for path, fwd in line_paths(model, support_on, t):
+        check_not_slack(model, X, path, fwd)
+    start = grounded_start(model, X, support_on, t)
     try:
         return _active_set(model, zb, start.copy(), h0, t, load_steps, max_rounds, ztol, fscale,
                            support_on)
@@ -56,8 +59,8 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
     penalty = ContactModel(model, SeabedContact.of_model(model, stiffness=k,
                                                          width=np.ones(mesh.n_elements)))
     pre = solve_static(penalty, X, None, t=t, load_steps=load_steps)
-    return _active_set(model, zb, pre.X, None, t, load_steps, max_rounds, ztol, fscale,
-                       support_on)
+    # pre is the equilibrium at the full loads: the active set starts there, without a ramp
+    return _active_set(model, zb, pre.X, None, t, 1, max_rounds, ztol, fscale, support_on)
 
 
 def _current_ramp(model, zb, X, args):
@@ -103,6 +106,7 @@ def _stage(model, zb, sol, contact, args):
     last = np.zeros_like(contact)
     last[conn[a & ~b, 0]] = True
     last[conn[b & ~a, 1]] = True
+    args = (args[0], 1, *args[2:])  # from the last stage's equilibrium at the full loads
     for trial in (contact, grow, contact & ~last):
         try:
             return _active_set(model, zb, sol.X.copy(), sol.state.h, *args, contact=trial)
@@ -123,6 +127,10 @@ def _active_set(model, zb, X, h0, t, load_steps, max_rounds, ztol, fscale, suppo
         gm = GroundedModel(model, contact, contact | support_on, zb)
         sol = solve_static(gm, X, h, t=t, load_steps=load_steps)
         X, h = sol.X, sol.state.h
+        # the next set starts from this one's equilibrium at the full loads: ramping the loads
+        # again from a fraction would start a fixed set, chosen for the full loads, far from
+        # its equilibrium at that fraction (where the set is not the right one)
+        load_steps = 1
         rz = seabed_push(gm, sol.state, X, t)  # what the seabed must push up with
         below = ~fixed_z & ~contact & (X[:, 2] < zb - ztol)
         pulling = contact & (rz < -1e-9 * fscale)
@@ -161,9 +169,12 @@ def seabed_push(gm: GroundedModel, state, X: np.ndarray, t: float) -> np.ndarray
     return r.reshape(-1, 3)[:, 2]
 
 
-def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray) -> np.ndarray:
+def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray, t: float = 0.0
+                   ) -> np.ndarray:
     """Nodes of every cable with exactly one end supported on the seabed (uniform w and EA,
-    no loads inside) placed on the grounded catenary of the whole cable; others unchanged."""
+    no loads inside) placed on the grounded catenary of the whole cable, and those of every
+    line of several cables in series from an anchor on the seabed to a support above it
+    (catdae.solvers.line_start) on the line's equilibrium; others unchanged."""
     mesh = model.mesh
     el = model.elements
     X = X.copy()
@@ -192,6 +203,9 @@ def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray) -> np.nd
         g.position_batch(h[None], np.array([w]), np.array([ea]), np.array([l0]),
                          np.array([mode]), s, out)
         X[inner] = X[a] + out[0]
+    for path, fwd in line_paths(model, on_support, t):
+        if np.unique(mesh.cable_of_element[path]).size > 1:
+            place_line(model, X, path, fwd)
     return X
 
 
@@ -238,9 +252,11 @@ def _check_slack_resting(gm: GroundedModel, sol, fscale: float) -> None:
 
 
 def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str, np.ndarray]:
-    """Per cable: unstrained length resting on the seabed, and the touchdown point (where the
-    line leaves the seabed for the suspended part; NaN when it does not touch or does not
-    leave)."""
+    """Per cable: unstrained length resting on the seabed, and the touchdown point: where the
+    suspended part that reaches the cable's upper end (the higher of its two ends, its second
+    end when they are level) leaves the seabed, i.e. the last contact point seen from the upper
+    end, whatever the cable's end order; NaN when the cable does not touch, or when its upper
+    end itself rests on the seabed (it does not leave it)."""
     mesh = gm.mesh
     nc = len(mesh.cable_names)
     lying = gm.elements.lying_length(h)
@@ -251,14 +267,18 @@ def seabed_summary(gm: GroundedModel, X: np.ndarray, h: np.ndarray) -> dict[str,
         els = np.flatnonzero(mesh.cable_of_element == ci)
         if length[ci] <= 0.0:
             continue
-        for e in els:
-            if gm.mode[e] in (g.AT_I, g.AT_J):
+        from_last = X[mesh.conn[els[-1], 1], 2] >= X[mesh.conn[els[0], 0], 2]
+        walk = els[::-1] if from_last else els
+        leaves = g.AT_I if from_last else g.AT_J  # the grounded mode whose free end faces up
+        for e in walk:
+            if gm.mode[e] == g.FREE:
+                continue
+            if gm.mode[e] == leaves:
                 s = np.zeros((mesh.n_elements, 1))
                 s[e, 0] = np.clip(-h[e, 2] / el.w[e], 0.0, el.L0[e])
                 touchdown[ci] = X[mesh.conn[e, 0]] + gm.elements.position(h, s)[e, 0]
-                break
+            break  # else the upper end rests on the seabed: the cable does not leave it
     return {"seabed_length": length, "touchdown": touchdown}
-
 
 
 def solve_static_on_seabed(model: Model, X, h0=None, t: float = 0.0, load_steps: int = 1):

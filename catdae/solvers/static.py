@@ -81,13 +81,35 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
             continue
         dlam *= 0.5
         model.elements.set_load_forces(lam * f_full)
-        if dlam < 1e-6:
+        # nothing to ramp (no loads): a smaller increment is the same Newton from the same start
+        if dlam < 1e-6 or not (model.has_internal_loads or np.any(p_full)):
             model.elements.set_load_forces(f_full)
             raise ConvergenceError(
                 f"static equilibrium not found: load factor stuck at {lam:.6g} "
-                f"(|R| = {rnorm:.3g} N after {total_iter} Newton iterations)")
+                f"(|R| = {rnorm:.3g} N after {total_iter} Newton iterations"
+                f"{_largest_residual(model, X_new, state_new, p)})")
     r = _residual(model, state, p_full, X)
     return StaticSolution(X, state, total_iter, float(np.abs(r).max(initial=0.0)), n_inc)
+
+
+def _largest_residual(model: Model, X, state, p) -> str:
+    """Where the out-of-balance force of the last iterate is largest: its node and axis, and
+    the elements there that could not be solved, for the failure's message."""
+    try:
+        r = _residual(model, state, p, X)
+    except (ValueError, FloatingPointError):
+        return ""
+    mesh = model.mesh
+    if r.size == 0 or not np.isfinite(r).any():
+        return ""
+    k = int(model.free[np.nanargmax(np.abs(r))])
+    node = k // 3
+    out = f"; largest at node {mesh.node_names[node]!r}, {'xyz'[k % 3]}: {abs(r).max():.3g} N"
+    near = np.flatnonzero((mesh.conn == node).any(axis=1) & (state.status == NOT_CONVERGED))
+    if near.size:
+        out += ", next to element(s) " + ", ".join(repr(mesh.element_names[e]) for e in near)
+        out += " that cannot be solved there"
+    return out
 
 
 def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
