@@ -104,7 +104,8 @@ def _largest_residual(model: Model, X, state, p) -> str:
         return ""
     k = int(model.free[np.nanargmax(np.abs(r))])
     node = k // 3
-    out = f"; largest at node {mesh.node_names[node]!r}, {'xyz'[k % 3]}: {abs(r).max():.3g} N"
+    big = float(np.nanmax(np.abs(r)))
+    out = f"; largest at node {mesh.node_names[node]!r}, {'xyz'[k % 3]}: {big:.3g} N"
     near = np.flatnonzero((mesh.conn == node).any(axis=1) & (state.status == NOT_CONVERGED))
     if near.size:
         out += ", next to element(s) " + ", ".join(repr(mesh.element_names[e]) for e in near)
@@ -119,6 +120,7 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
     rn = np.linalg.norm(r)
     if free.size == 0:
         return True, X, state, 0, rn
+    cap = float(model.mesh.L0.max(initial=1.0))  # m, the longest Newton step
     for it in range(1, max_iter + 1):
         tscale = max(fscale, float(np.abs(state.h).max(initial=0.0)))
         if rn <= rtol * tscale:
@@ -127,6 +129,12 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
         dx = _solve(k, -r)
         if dx is None:
             return False, X, state, it, rn
+        # a step longer than an element (a load across a cable that carries no tension yet:
+        # K nearly singular) is shortened to one: the line search then starts where the
+        # elements can still be solved
+        big = float(np.abs(dx).max())
+        if big > cap:
+            dx *= cap / big
         step = _line_search(model, X, state, dx, r, rn, p)
         if step is None:
             # no decrease: converged to round-off, or stuck

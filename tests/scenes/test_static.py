@@ -312,3 +312,52 @@ def test_gravity_only_reactions_carry_the_weight():
     assert R[2] == pytest.approx(weight, rel=1e-10)
     np.testing.assert_allclose(R[:2], 0.0, atol=1e-10 * weight)
     check_equilibrium(case, ds)
+
+
+LIGHT_LINE = """
+title = "a nearly weightless line pulled aside by its bob"
+[materials.rope]
+EA = 1.0e9
+mass = 40.0
+weight = {w}
+[nodes]
+A = [0.0, 0.0, -5.0]
+B = [0.0, 0.0, -25.0]
+[supports]
+A = "pinned"
+[[cables]]
+name = "line"
+ends = ["A", "B"]
+material = "rope"
+length = 20.0
+elements = {n}
+[[point_masses]]
+name = "bob"
+node = "B"
+mass = 200.0
+[[loads]]
+name = "pull"
+node = "B"
+force = [1500.0, 0.0, 0.0]
+[[steps]]
+kind = "static"
+name = "eq"
+load_steps = {steps}
+"""
+
+
+@pytest.mark.parametrize(("w", "n", "steps"), [(0.1, 1, 4), (0.1, 1, 1), (6.6e-4, 1, 2)])
+def test_a_line_that_carries_no_tension_yet_is_pulled_aside(w, n, steps):
+    """A line hanging straight down (tension only from its own 0.1 N/m, or nearly neutral in
+    water) gets its bob's weight and a side pull: the first Newton step, across a line with
+    almost no lateral stiffness, was 7.5e13 m long and the solve stalled at load factor 0 for
+    any load_steps > 1 (an independent tester's case). The answer is the weightless link to
+    within the line's own weight: B at L0 (1 + T/EA) along (P, 0, -Mg) / T from A."""
+    text = LIGHT_LINE.format(w=w, n=n, steps=steps)
+    ds = catdae.run(case_from_dict(__import__("tomllib").loads(text)))["eq"].ds
+    P, W = 1500.0, 200.0 * 9.81
+    T = math.hypot(P, W)
+    x = np.array([0.0, 0.0, -5.0]) + 20.0 * (1 + T / 1.0e9) * np.array([P, 0.0, -W]) / T
+    weight = w * 20.0  # N: it tilts the line by about weight / T
+    assert np.abs(ds.position.sel(node="B").values - x).max() < 20.0 * weight / T + 1e-9
+    assert float(ds.tension.max()) == pytest.approx(T, abs=weight + 1e-6)
