@@ -34,6 +34,7 @@ class StepHook:
     def __init__(self, run, bar):
         self.run = run
         self.bar = bar
+        self.shift = getattr(run, "shift", None)  # IDA's y are displacements (§18.7)
         self.work = run.outputs.work
         self.envelope = run.outputs.envelope
         self.race = run.order_choice if (run.order_choice is not None
@@ -96,7 +97,7 @@ class StepHook:
         if t > self.t_seen and self.t_flag is None:
             self.t_seen = t
             if t != self.tout or t == self.tstop:  # the end of an accepted step
-                self._step(t, y, yp)
+                self._step(t, y if self.shift is None else self.shift.view(y, "hook"), yp)
         events[0] = -1.0 if self.t_flag is not None and t >= self.t_flag else 1.0
 
     def _step(self, t: float, y, yp) -> None:

@@ -30,6 +30,7 @@ from catdae.progress import reporter
 from catdae.solvers.order import OrderChoice, highest_frequency, reference_frequency
 from catdae.solvers.record import OutputRecord, note
 from catdae.solvers.residual import TransientProblem
+from catdae.solvers.shift import Shift
 from catdae.solvers.step_hook import StepHook
 from catdae.solvers.tolerance import error_weights, resolve_mode
 
@@ -138,6 +139,7 @@ class _Run:
         self.dt_out = float(step.output_interval)
         self.times = output_times(self.t0, float(step.duration), self.dt_out)
         self.y0, self.yp0 = prob.initial(self.t0, state.X, state.V)
+        self.shift = Shift(self.y0)  # IDA works on displacements from here (§18.7)
         self.V_start = state.V
         self.X_start, self.h_start = state.X, state.h
         self._ida_options()
@@ -171,11 +173,12 @@ class _Run:
                        max_num_steps=100000, linsolver=self.linsolver)
         if self.linsolver == "band":
             bw = prob.bandwidth
-            options.update(lband=2 * bw + 1, uband=max(2 * bw, 1), jacfn=prob.jac_dense)
+            options.update(lband=2 * bw + 1, uband=max(2 * bw, 1),
+                           jacfn=self.shift.jacobian(prob.jac_dense))
         elif self.linsolver == "sparse":
-            options.update(sparsity=prob.j_pattern, jacfn=prob.jac_sparse)
+            options.update(sparsity=prob.j_pattern, jacfn=self.shift.jacobian(prob.jac_sparse))
         else:
-            options.update(jacfn=prob.jac_dense)
+            options.update(jacfn=self.shift.jacobian(prob.jac_dense))
         self.options = options
 
     def make_solver(self, max_order: int) -> IDA:
@@ -184,8 +187,9 @@ class _Run:
             # that is the intent (the analytic iteration matrix)
             warnings.filterwarnings("ignore", "Custom sparse Jacobian approximation",
                                     UserWarning)
-            return IDA(self.prob.resfn, **dict(self.options, max_order=max_order),
-                       eventsfn=self.hook, num_events=1)
+            return IDA(self.shift.residual(self.prob.resfn),
+                       **dict(self.options, max_order=max_order), eventsfn=self.hook,
+                       num_events=1)
 
     # ------------------------------------------------------------------ attributes
     def attributes(self, n_valid: int) -> dict:
@@ -304,12 +308,12 @@ class _Run:
                     and t_int >= t_stop - 1e-13 * max(abs(t_stop), 1.0)):
                 t_int = t_stop
                 i_stop += 1
-                self._restart(solver, t_stop, res.y, befores[i_stop - 1],
+                self._restart(solver, t_stop, self.shift.from_ida(res.y), befores[i_stop - 1],
                               more=i_stop < len(stops))
                 hook.reset(t_stop)
                 first = True
             elif not first:
-                self.outputs.record(self.k_done, t_int, res.y, res.yp)
+                self.outputs.record(self.k_done, t_int, self.shift.view(res.y, "out"), res.yp)
                 self.k_done += 1
             else:
                 first = False
@@ -323,7 +327,7 @@ class _Run:
         if writer is not None and writer.output is not None:
             hook.written(every=INCREMENT_SECONDS)  # snapshots of a long run
         solver = self.make_solver(self.options["max_order"])
-        solver.init_step(self.t0, self.y0, self.yp0)
+        solver.init_step(self.t0, self.shift.to_ida(self.y0), self.yp0)
         self.outputs.record(0, self.t0, self.y0, self.yp0)
         if self.outputs.work is not None:  # the fluid's work, None without a fluid
             self.outputs.work.advance(self.t0, self.y0, self.yp0)
@@ -348,7 +352,8 @@ class _Run:
             self.status = (f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
                            f"{self.prob.n_rejected} trial states rejected)")
             return None, t, False
-        solver, t, fresh = self._change_order(solver, new_order, t, res.y, res.yp)
+        solver, t, fresh = self._change_order(solver, new_order, t,
+                                              self.shift.from_ida(res.y), res.yp)
         self.hook.reset(t)  # IDA goes on from t: nothing asked of it, nothing seen after t
         return solver, t, fresh
 
@@ -377,7 +382,7 @@ class _Run:
             self.n_rollbacks += 1
             return solver, t_int, False
         new = self.make_solver(order)
-        new.init_step(t_int, y_last, yp_last)
+        new.init_step(t_int, self.shift.to_ida(y_last), yp_last)
         return new, t_int, True
 
     def _restart(self, solver, t_stop: float, y_last, before, more: bool) -> None:
@@ -390,7 +395,7 @@ class _Run:
             work.advance(t_stop, y_last, yp_last)
         self.n_restarts += 1
         if more:
-            solver.init_step(t_stop, y_last, yp_last)
+            solver.init_step(t_stop, self.shift.to_ida(y_last), yp_last)
             if self.order_choice is not None:
                 self.order_choice.restart()
         times = self.times
