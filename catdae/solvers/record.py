@@ -53,6 +53,17 @@ class OutputRecord:
         return self
 
 
+def output_times(t0: float, duration: float, dt_out: float) -> np.ndarray:
+    """t0, t0 + dt, ... and the end exactly (the next step starts there)."""
+    t_end = t0 + duration
+    n_out = int(np.floor((t_end - t0) / dt_out + 1e-9)) + 1
+    times = t0 + dt_out * np.arange(n_out)
+    if times[-1] < t_end - 1e-9 * dt_out:
+        times = np.append(times, t_end)
+    times[-1] = t_end
+    return times
+
+
 def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
     """Strain energy ∫T²/(2EA) ds and potential of gravity and constant loads, J (loads with a
     time function have no potential: their work changes the total energy)."""

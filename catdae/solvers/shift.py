@@ -21,9 +21,10 @@ class Shift:
     signature of the kernels), from a buffer per caller (``slot``) that the next call of
     the same caller overwrites."""
 
-    def __init__(self, y0: np.ndarray):
+    def __init__(self, y0: np.ndarray, resfn):
         self.q0 = np.array(y0[0::2], dtype=float, copy=True)
         self._buffers: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.resfn = self.residual(resfn)  # the problem's residual, as IDA calls it
 
     def to_ida(self, y: np.ndarray) -> np.ndarray:
         u = np.array(y, dtype=float, copy=True)

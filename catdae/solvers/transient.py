@@ -21,14 +21,12 @@ import time as _time
 import types
 import warnings
 
-import numpy as np
-
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.model.snap import jump_floor, velocity_jumps
 from catdae.progress import reporter
 from catdae.solvers.order import OrderChoice, highest_frequency, reference_frequency
-from catdae.solvers.record import OutputRecord, note
+from catdae.solvers.record import OutputRecord, note, output_times
 from catdae.solvers.residual import TransientProblem
 from catdae.solvers.shift import Shift
 from catdae.solvers.step_hook import StepHook
@@ -95,17 +93,6 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
     return "sparse"
 
 
-def output_times(t0: float, duration: float, dt_out: float) -> np.ndarray:
-    """t0, t0 + dt, ... and the end exactly (the next step starts there)."""
-    t_end = t0 + duration
-    n_out = int(np.floor((t_end - t0) / dt_out + 1e-9)) + 1
-    times = t0 + dt_out * np.arange(n_out)
-    if times[-1] < t_end - 1e-9 * dt_out:
-        times = np.append(times, t_end)
-    times[-1] = t_end
-    return times
-
-
 def run_transient(step, model: Model, state, writer, progress) -> OutputRecord:
     """Integrate one transient step from ``state`` (positions, velocities, tensions): the
     output record (arrays and attributes). On failure or interrupt the record of what was
@@ -139,7 +126,7 @@ class _Run:
         self.dt_out = float(step.output_interval)
         self.times = output_times(self.t0, float(step.duration), self.dt_out)
         self.y0, self.yp0 = prob.initial(self.t0, state.X, state.V)
-        self.shift = Shift(self.y0)  # IDA works on displacements from here (§18.7)
+        self.shift = Shift(self.y0, prob.resfn)  # IDA works on displacements from here
         self.V_start = state.V
         self.X_start, self.h_start = state.X, state.h
         self._ida_options()
@@ -173,12 +160,12 @@ class _Run:
                        max_num_steps=100000, linsolver=self.linsolver)
         if self.linsolver == "band":
             bw = prob.bandwidth
-            options.update(lband=2 * bw + 1, uband=max(2 * bw, 1),
-                           jacfn=self.shift.jacobian(prob.jac_dense))
+            options.update(lband=2 * bw + 1, uband=max(2 * bw, 1), jacfn=prob.jac_dense)
         elif self.linsolver == "sparse":
-            options.update(sparsity=prob.j_pattern, jacfn=self.shift.jacobian(prob.jac_sparse))
+            options.update(sparsity=prob.j_pattern, jacfn=prob.jac_sparse)
         else:
-            options.update(jacfn=self.shift.jacobian(prob.jac_dense))
+            options.update(jacfn=prob.jac_dense)
+        options["jacfn"] = self.shift.jacobian(options["jacfn"])  # IDA's y: displacements
         self.options = options
 
     def make_solver(self, max_order: int) -> IDA:
@@ -187,9 +174,8 @@ class _Run:
             # that is the intent (the analytic iteration matrix)
             warnings.filterwarnings("ignore", "Custom sparse Jacobian approximation",
                                     UserWarning)
-            return IDA(self.shift.residual(self.prob.resfn),
-                       **dict(self.options, max_order=max_order), eventsfn=self.hook,
-                       num_events=1)
+            return IDA(self.shift.resfn, **dict(self.options, max_order=max_order),
+                       eventsfn=self.hook, num_events=1)
 
     # ------------------------------------------------------------------ attributes
     def attributes(self, n_valid: int) -> dict:
@@ -352,8 +338,7 @@ class _Run:
             self.status = (f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
                            f"{self.prob.n_rejected} trial states rejected)")
             return None, t, False
-        solver, t, fresh = self._change_order(solver, new_order, t,
-                                              self.shift.from_ida(res.y), res.yp)
+        solver, t, fresh = self._change_order(solver, new_order, t, res.y, res.yp)
         self.hook.reset(t)  # IDA goes on from t: nothing asked of it, nothing seen after t
         return solver, t, fresh
 
@@ -382,7 +367,7 @@ class _Run:
             self.n_rollbacks += 1
             return solver, t_int, False
         new = self.make_solver(order)
-        new.init_step(t_int, self.shift.to_ida(y_last), yp_last)
+        new.init_step(t_int, y_last, yp_last)  # IDA's own y (displacements, §18.7)
         return new, t_int, True
 
     def _restart(self, solver, t_stop: float, y_last, before, more: bool) -> None:
