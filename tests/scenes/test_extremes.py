@@ -511,7 +511,8 @@ def test_taut_cable_free_vibration_keeps_its_amplitude_over_100_periods():
 
 def test_taut_cable_free_vibration_over_1000_periods():
     """1000 fundamental periods: the frequency read from the whole record equals the modal
-    step's (phase kept to 1 % of a period after 1000), and amplitude and energy hold to 1 %."""
+    step's (phase kept to 1 % of a period after 1000), the amplitude holds to 1.5 % and the
+    total energy to 1.5 % of the kinetic energy's peak."""
     n_per, per_out = 1000, 8
     text, _, _, period = _taut_release(n_per, per_out, rtol=1e-7, atol=1e-10,
                                        more_steps=modal(1))
@@ -537,7 +538,10 @@ def test_taut_cable_free_vibration_over_1000_periods():
     a1 = np.abs(y[-per_out - 1:]).max()
     assert abs(a1 / a0 - 1) < 0.015, (a0, a1)
     e = ds.energy_total.values
-    assert np.abs(e - e[0]).max() < 0.01 * ds.energy_kinetic.values.max()
+    # 1.1 % measured (0.65 % when IDA's unknowns were the coordinates: rtol now weighs the
+    # displacement from the released state, up to twice the amplitude, docs/theory.md §18.7,
+    # so the run takes 13 % fewer steps at order 5)
+    assert np.abs(e - e[0]).max() < 0.015 * ds.energy_kinetic.values.max()
 
 
 @pytest.mark.parametrize(("duration", "dt", "n"), [(0.01, 0.01, 2), (1e-6, 1e-6, 2),

@@ -38,14 +38,16 @@ def _values(ds: xr.Dataset, name: str) -> np.ndarray:
 def test_error_shrinks_as_the_tolerance_tightens():
     # Example 2, gentle scene, 0.3 s on 4 elements. atol is held far below rtol x motion so
     # that rtol controls the error; the reference (same mesh, rtol/100) then measures the time
-    # integration error alone. Measured: 2.3e-5, 4.5e-7, 1.5e-8 m.
+    # integration error alone. Measured: 7.1e-7, 9.0e-8, 3.2e-9 m (3.0e-6, 1.1e-7, 4.2e-9 when
+    # rtol weighed the coordinates rather than the displacements, docs/theory.md §18.7: the
+    # loosest run gained most, so the first ratio is now 7.9, the second 28).
     ds = run_study(GENTLE, rtol=[1e-3, 1e-5, 1e-7], atol=[1e-10], elements=[4], duration=0.3,
                    scheduler="synchronous")
     assert ds.attrs["reference_rtol"] == pytest.approx(1e-9)
     assert ds.attrs["reference_elements"] == 4
     assert (ds.status.values == "completed").all()
     err = _values(ds, "error")
-    assert err[0] > 10 * err[1] > 100 * err[2] > 0
+    assert err[0] > 5 * err[1] > 50 * err[2] > 0
     assert (np.diff(_values(ds, "n_residual_evaluations")) > 0).all()  # tighter costs more
     assert (_values(ds, "peak_memory") >= 0).all()
     assert ds.attrs["peak_memory_method"] in ("peak_rss", "maxrss")
