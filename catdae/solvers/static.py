@@ -136,6 +136,8 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
         if big > cap:
             dx *= cap / big
         step = _line_search(model, X, state, dx, r, rn, p)
+        if step is None and rn > 1e3 * rtol * tscale:
+            step = _regularised_step(model, X, state, k, r, rn, p, cap)
         if step is None:
             # no decrease: converged to round-off, or stuck
             return rn <= 1e3 * rtol * tscale, X, state, it, rn
@@ -144,6 +146,17 @@ def _newton(model: Model, X, state, p, fscale, rtol, max_iter):
         if alpha == 1.0 and np.abs(dx).max() <= 1e-14 * max(1.0, np.abs(X).max()):
             return True, X, state, it, rn
     return rn <= rtol * fscale, X, state, max_iter, rn
+
+
+def _regularised_step(model: Model, X, state, k, r, rn: float, p, cap: float):
+    """A Levenberg-Marquardt step where the Newton direction found no decrease: the Newton
+    direction of a cable that carries almost no tension yet (a line hanging straight down,
+    pulled aside) is its mechanism, a lateral sweep of the inner nodes; K + μ I with μ = |R| /
+    cap (the stiffness that moves a node by the longest element under the whole residual)
+    turns it towards the residual, and the stiff directions keep Newton's step."""
+    kk = k + (rn / cap) * sp.identity(k.shape[0], format="csc")
+    dx = _solve(kk, -r)
+    return None if dx is None else _line_search(model, X, state, dx, r, rn, p)
 
 
 def _line_search(model: Model, X, state, dx, r, rn, p):
