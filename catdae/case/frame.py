@@ -122,11 +122,24 @@ def _air(air, rot):
 
 def rotate_back(ds, R: np.ndarray | None):
     """Every variable with an ``axis`` dimension (last) rotated from the local to the global
-    frame: v = Rᵀ v_local."""
+    frame: v = Rᵀ v_local. A NaN component (a reaction on an axis a support leaves free) stays
+    NaN only on the global axes it reaches; a mode shape is scaled again to a largest component
+    of +1 in the case's axes; the ``axis`` label says the axes are the case's."""
     if R is None:
         return ds
     out = ds.copy()
     for name, var in ds.data_vars.items():
         if var.dims and var.dims[-1] == "axis":
-            out[name] = var.copy(data=np.asarray(var.values) @ R)
+            v = np.asarray(var.values)
+            nan = np.isnan(v)
+            g = np.where(nan, 0.0, v) @ R
+            if nan.any():
+                g[(nan.astype(float) @ (np.abs(R) > _TOL)) > 0] = np.nan
+            if name == "shape":  # (mode, node, axis): the largest component +1 again
+                flat = g.reshape(g.shape[0], -1)
+                g = g / flat[np.arange(flat.shape[0]), np.nanargmax(np.abs(flat), axis=1)][
+                    :, None, None]
+            out[name] = var.copy(data=g)
+    if "axis" in out.coords:
+        out.coords["axis"].attrs["long_name"] = "axis of the case (gravity along the group's -up)"
     return out

@@ -116,3 +116,41 @@ def test_bad_gravity_names_the_field(value, fragment):
     with pytest.raises(CaseError) as err:
         catdae.load_case(scene(np.eye(3), value, motion=False))
     assert fragment in dict(err.value.problems)["gravity"]
+
+
+def test_a_partial_support_reacts_on_its_fixed_axes_under_a_gravity_vector():
+    """B held in x and z only (upright), the same scene turned so that up is y and B is held in
+    x and y: its reaction is the upright one turned, NaN only on the axis it leaves free (the
+    NaN of the free local axis spread to all three global ones), in the static and the
+    transient step."""
+    R = rotation([1.0, 0.0, 0.0], np.pi / 2)
+    held = np.abs(R @ np.array([1.0, 0.0, 1.0])) > 0.5
+    turned_axes = [a for a, h in zip("xyz", held, strict=True) if h]
+    a = catdae.run(catdae.load_case(scene(np.eye(3), 9.81, supports=("A", 'B = ["x", "z"]'),
+                                          motion=False)))
+    b = catdae.run(catdae.load_case(scene(R, R @ np.array([0.0, 0.0, -9.81]), supports=(
+        "A", f"B = {turned_axes!r}".replace("'", '"')), motion=False)))
+    for step in ("s", "t"):
+        up = a[step].ds.reaction.sel(node="B").values  # NaN on y, the free axis
+        want = np.where(np.isnan(up), 0.0, up) @ R.T
+        want[..., ~held] = np.nan
+        got = b[step].ds.reaction.sel(node="B").values
+        assert np.array_equal(np.isnan(got), np.isnan(want))
+        assert np.isfinite(got).sum() == 2 * got.size // 3  # two axes held
+        assert np.allclose(got, want, rtol=1e-6, atol=1e-6 * np.nanmax(np.abs(want)),
+                           equal_nan=True)
+
+
+def test_mode_shapes_have_a_largest_component_of_one_in_the_case_axes(upright):
+    R = rotation([1.0, 2.0, 0.5], 0.7)
+    turned = catdae.run(catdae.load_case(scene(R, R @ np.array([0.0, 0.0, -9.81]))))
+    shape = turned["m"].ds["shape"].values.reshape(4, -1)
+    top = shape[np.arange(4), np.abs(shape).argmax(axis=1)]
+    assert np.allclose(top, 1.0, rtol=0, atol=1e-12)
+    want = (upright["m"].ds["shape"].values @ R.T).reshape(4, -1)
+    want /= want[np.arange(4), np.abs(want).argmax(axis=1)][:, None]
+    f = upright["m"].ds.frequency.values
+    single = [k for k in range(4) if np.min(np.abs(np.delete(f, k) / f[k] - 1)) > 1e-6]
+    assert single  # compare the shapes of the modes that are not one of a degenerate pair
+    assert np.allclose(shape[single], want[single], atol=1e-8)
+    assert "case" in turned["m"].ds.axis.attrs["long_name"]
