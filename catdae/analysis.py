@@ -183,14 +183,15 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
     temperature after it are those of the last value. Returns (dataset, temperature)."""
     start = copy.deepcopy(state)
     groups = []
+    field = step.sweep.field
+    settle = not field.startswith("dampers.")  # a damper moves no equilibrium
     for value in step.sweep.values:
         case_v, step_v = apply_sweep(case, step, value)
         temp_v = temperature if step_v.temperature_change is None else step_v.temperature_change
         run_state = copy.deepcopy(start)
         model = step_model(case_v, mesh.heated(case_v, temp_v), absent, step, run_state)
-        groups.append(_run_step(step_v, model, run_state, None, progress))
+        groups.append(_run_step(step_v, model, run_state, None, progress, settle=settle))
     state.__dict__.update(run_state.__dict__)
-    field = step.sweep.field
     ds = xr.concat(groups, dim="sweep", combine_attrs="drop_conflicts")
     varying = sorted({k for g in groups for k in g.attrs} - set(ds.attrs))  # differ by value
     for key in varying:
@@ -217,10 +218,18 @@ def step_model(case: Case, mesh, absent: set[str], step: Step, state: _State) ->
     return model
 
 
-def _run_step(step: Step, model: Model, state: _State, writer, progress) -> xr.Dataset:
+def _run_step(step: Step, model: Model, state: _State, writer, progress,
+              settle: bool = False) -> xr.Dataset:
+    """One step's dataset. A modal step that changes the scene (``add``, ``remove``,
+    ``temperature_change``, or ``settle``: a swept value that moves the equilibrium) first
+    finds the static equilibrium of its own scene, and its modes are about that state."""
     if step.kind == "static":
         return _static_step(step, model, state)
     if step.kind == "modal":
+        if settle or step.add or step.remove or step.temperature_change is not None:
+            its = _static_step(step, model, state).attrs["iterations"]
+            return _modal_step(step, model, state).assign_attrs(equilibrium=(
+                f"found again for the step's own scene ({its} Newton iterations)"))
         return _modal_step(step, model, state)
     from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 
