@@ -92,8 +92,36 @@ def note(model: Model, prob, rec: OutputRecord | None = None, n_valid: int = 0) 
     """Advice on the result's accuracy that the run itself found ("" when none): on the mass
     model, and (given the record and its ``n_valid`` outputs) an energy balance that does not
     close (catdae/solvers/energy_check.py)."""
-    advice = [_mass_note(model, prob), gain_note(model, prob, rec, n_valid)]
+    advice = [_mass_note(model, prob), gain_note(model, prob, rec, n_valid),
+              _slack_note(model, rec, n_valid)]
     return "; ".join(a for a in advice if a)
+
+
+SLACK, SNAP = 0.1, 3.0  # an element end that fell below SLACK of its start tension and rose
+# above SNAP times it during a step went nearly slack and snapped taut
+
+
+def _slack_note(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
+    """A catenary (consistent or blended) mass and an element end whose tension envelope fell
+    below SLACK of its tension at the start and rose above SNAP times it: the line went nearly
+    slack and snapped taut, which only a mass that carries axial waves carries in full
+    (docs/accuracy.md; an independent tester's smooth but violent support motion: +33 % on
+    the peak tension with the blended mass, not converging with rtol or the mesh)."""
+    if rec is None or n_valid < 1 or not model.mass_model.catenary:
+        return ""
+    env = rec.envelope
+    start = rec.T[0]
+    loaded = start > 0.0
+    fell = loaded & (env.t_min < SLACK * start) & (env.t_max > SNAP * start)
+    if not fell.any():
+        return ""
+    e, k = np.argwhere(fell)[np.argmin((env.t_min / np.where(loaded, start, 1.0))[fell])]
+    return (f"element {model.mesh.element_names[e]!r} went nearly slack and snapped taut "
+            f"(tension {env.t_min[e, k]:.4g} N at t = {env.time_min[e, k]:.6g} s, "
+            f"{start[e, k]:.4g} N at the start, up to {env.t_max[e, k]:.4g} N): a snap "
+            f"after slack is carried in full only by a mass that carries axial waves, and "
+            f"mass_model {model.mass_model.name!r} does not: compare the peak tension with "
+            "mass_model = \"lumped\" (docs/accuracy.md)")
 
 
 def _mass_note(model: Model, prob) -> str:
