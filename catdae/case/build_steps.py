@@ -19,6 +19,7 @@ from catdae.case.model import (
     Step,
     SupportMotion,
 )
+from catdae.case.names import cable_of
 from catdae.case.schema import (
     DAMPING_MODELS,
     STEP_MODELS,
@@ -40,8 +41,12 @@ class StepsPass:
             if v is None:
                 continue
             if v.node not in self.node_names:
-                self.problem(where + ("node",),
-                             unknown_word(v.node, "node", sorted(self.node_names)))
+                mesh = cable_of(v.node) in self.cable_names  # a node of a cable's mesh
+                self.problem(where + ("node",), (
+                    f"{v.node!r} is a mesh node of cable {cable_of(v.node)!r}, and mesh nodes "
+                    "cannot be supported: only a [nodes] entry that is in [supports] can be "
+                    f"moved (supported nodes: {', '.join(map(repr, sorted(self.support_names)))})"
+                ) if mesh else unknown_word(v.node, "node", sorted(self.node_names)))
                 ok = False
             elif v.node not in self.support_names:
                 self.problem(where + ("node",), f"node {v.node!r} is not supported; only a "

@@ -126,13 +126,15 @@ class TimePass:
                 self.problem(where + ("value",), f"expected {len(t)} values, one per time in "
                              f"t, found {len(value)}")
                 return None
+        src = f"{shorten(v.file)}: " if v.file is not None else ""  # a file's rows: name it
         if len(t) < 2:
-            self.problem(at, f"expected at least 2 points, found {len(t)}")
+            self.problem(at, f"{src}expected at least 2 points, found {len(t)}")
             return None
         for j in range(1, len(t)):
             if not t[j] > t[j - 1]:
-                self.problem(at, "expected strictly increasing times, found "
-                             f"{t[j - 1]:g} then {t[j]:g} (point {j})")
+                where_j = f"data rows {j} and {j + 1}" if src else f"point {j}"
+                self.problem(at, f"{src}expected strictly increasing times, found "
+                             f"{t[j - 1]:g} then {t[j]:g} ({where_j})")
                 return None
         t, value = tuple(float(x) for x in t), tuple(float(x) for x in value)
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -189,6 +191,13 @@ class TimePass:
             header = lines[0][1]  # a header line such as "time,value" or "t,ax,ay,az"
             lines = lines[1:]
         width = len(header) if header is not None else len(lines[0][1]) if lines else 2
+        first = lines[0][1] if lines else (header or [])  # a data row, else the header
+        sep = next((c for c in (";", "\t", " ") if len(first) == 1 and c in first[0]), None)
+        if sep is not None:  # one column: another separator than the comma
+            self.problem(where, f"{name} has one column per line, its values separated by "
+                         f"{'a tab' if sep == chr(9) else repr(sep)}: catdae reads CSV, values "
+                         "separated by commas (e.g. t,ax)")
+            return None
         if column is None and width != 2:
             names = f" ({_columns(header)})" if header is not None else ""
             self.problem(where, f"{name} has {width} columns{names}: choose the value column "

@@ -144,7 +144,22 @@ def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
 
     (tmp_path / "three.csv").write_text("t,ax,ay\n0.0,0.0,1.0\n1.0,0.0,2.0\n")
     (tmp_path / "bare.csv").write_text("0.0,0.0,1.0\n1.0,0.0,2.0\n")
+    (tmp_path / "back.csv").write_text("t,ax\n0.0,0.0\n0.2,1.0\n0.1,2.0\n")
+    (tmp_path / "one.csv").write_text("t,ax\n0.0,0.0\n")
+    (tmp_path / "semi.csv").write_text("t;ax\n0.0;0.0\n1.0;2.0\n")
+    (tmp_path / "tabs.csv").write_text("t\tax\n0.0\t0.0\n1.0\t2.0\n")
     motions = [
+        ({"kind": "table", "file": "back.csv", "column": "ax"},  # the file named, its rows
+         "support_motions[0].x.file: 'back.csv': expected strictly increasing times, found "
+         "0.2 then 0.1 (data rows 2 and 3)"),
+        ({"kind": "table", "file": "one.csv", "column": "ax"},
+         "support_motions[0].x.file: 'one.csv': expected at least 2 points, found 1"),
+        ({"kind": "table", "file": "semi.csv", "column": "ax"},  # not the column's fault
+         "support_motions[0].x.file: semi.csv has one column per line, its values separated "
+         "by ';': catdae reads CSV, values separated by commas"),
+        ({"kind": "table", "file": "tabs.csv"},
+         "support_motions[0].x.file: tabs.csv has one column per line, its values separated "
+         "by a tab"),
         ({"kind": "table", "file": "three.csv", "column": "ayy", "quantity": "acceleration"},
          "support_motions[0].x.column: three.csv has no column 'ayy'; did you mean 'ay'? (its "
          "columns: t, ax, ay; time is the first)"),
@@ -173,6 +188,14 @@ def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
         assert f"{case}: {message}" in err, err
         assert (f"{case}: loads[0].time.quantity: quantity = 'velocity' applies to support "
                 "motions only") in err
+    case.write_text(cable_scene(  # a mesh node cannot be moved: says why, not 'unknown'
+        B=(10.0, 0.0, 0.0), L0=10.2, EA=1e7, mass=1.0, elements=2,
+        extra=support_motion("c.1", x={"kind": "sine", "amplitude": 0.1, "frequency": 1.0}),
+        steps=transient_step("s", 1.0, 0.1, rtol=1e-6, atol=1e-8)))
+    assert main(["check", str(case)]) == 2
+    err = capsys.readouterr().err
+    assert (f"{case}: support_motions[0].node: 'c.1' is a mesh node of cable 'c', and mesh "
+            "nodes cannot be supported") in err, err
 
 
 def test_velocity_and_displacement_columns_through_the_case_format(tmp_path):
