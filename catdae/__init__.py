@@ -44,10 +44,13 @@ def load_case(path_or_text, **kwargs):
 
 
 def read_results(path):
-    """Open a results file written by catdae as an ``xarray.DataTree`` (in memory)."""
-    from catdae.output.results import read_tree
+    """Open a results file written by catdae as an ``xarray.DataTree`` (in memory). Raises
+    ``catdae.errors.ResultsError`` (a ``CatdaeError``) for a missing, empty, truncated,
+    corrupted or foreign file, as ``catdae plot`` reports it (a file of a run that failed
+    before its first step is returned: it holds the status)."""
+    from catdae.output.reading import read_results_file
 
-    return read_tree(path)
+    return read_results_file(path, steps=False)
 
 
 __all__ = ["CaseError", "CatdaeError", "ConvergenceError", "Interrupted", "OutputError",

@@ -317,6 +317,8 @@ class Case:
     path: str | None = None
     text: str = field(default="", repr=False)
     name: str = "case"
+    # settings given over the case file's (with_overrides: --rtol, --elements, ...), in order
+    overrides: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self):
         for key in ("materials", "nodes", "supports"):

@@ -95,8 +95,9 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
             for x in getattr(self, section)) for section in ("springs", "dampers", "bars")}
     else:
         connectors = {}
+    done = dict(self.overrides) | {k: v for k, v in given.items() if v is not None}
     case = replace(self, steps=steps, cables=cables, point_masses=point_masses,
-                   loads=loads, **connectors)
+                   loads=loads, overrides=tuple(done.items()), **connectors)
     problems = size_problems(case)  # more elements: the limits are judged again
     if problems:
         raise CaseError(self.path, problems)

@@ -95,10 +95,12 @@ def _value_attr(v, k: int, n: int):
     return v
 
 
-def read_results_file(path: str | os.PathLike) -> xr.DataTree:
-    """A results file for ``catdae plot`` and ``export``: read, and judged to be catdae's
-    (at least one step group, each with the variables of its kind). Raises ResultsError
-    ("cannot read ...") for a missing, empty, truncated, corrupted or foreign file."""
+def read_results_file(path: str | os.PathLike, steps: bool = True) -> xr.DataTree:
+    """A results file for ``catdae plot`` and ``export``: read, and judged to be catdae's (at
+    least one step group, each with the variables of its kind; with ``steps`` False a file of
+    catdae's without any, from a run that failed before its first step, is returned). Raises
+    ResultsError ("cannot read ...") for a missing, empty, truncated, corrupted or foreign
+    file."""
     path = Path(path)
     if not path.is_file():
         why = "no such file" if not path.exists() else "not a regular file"
@@ -111,6 +113,8 @@ def read_results_file(path: str | os.PathLike) -> xr.DataTree:
         why = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
         raise ResultsError(f"cannot read {path}: not a readable netCDF-4 results file "
                            f"({why})") from None
+    if not tree.children and not steps and "catdae_version" in tree.attrs:
+        return tree  # a run that failed before its first step: its status, no step results
     if not tree.children:
         raise ResultsError(f"cannot read {path}: it holds no step results (no groups; is it "
                            "a file written by catdae run?)")

@@ -176,7 +176,9 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
     (catdae.output.environment).
     """
     created = datetime.now(UTC).isoformat(timespec="seconds")
-    history = f"{created} catdae {__version__}: run of case {case.name!r} ({status})"
+    given = ", ".join(f"{k} = {v!r}" for k, v in getattr(case, "overrides", ()))
+    over = f" with {given} over the case file's" if given else ""
+    history = f"{created} catdae {__version__}: run of case {case.name!r}{over} ({status})"
     root = xr.Dataset(attrs=clean_attrs({
         "title": case.title,
         "source": case.source,
@@ -187,6 +189,7 @@ def make_tree(case, groups: dict[str, xr.Dataset], status: str = "completed") ->
         "status": status,
         "Conventions": CONVENTIONS,
         "history": history,
+        **({"overrides": given} if given else {}),  # case_toml with these re-runs the results
     }))
     env = environment_attrs(case)  # the water surface and seabed (figures, the VTK export)
     groups = {k: v.assign_attrs(Conventions=CONVENTIONS, history=history,

@@ -338,3 +338,32 @@ def test_a_run_leaves_numpy_f2py_and_testing_to_their_first_use(tmp_path):
                           timeout=300)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.strip().endswith("ok")
+
+
+def test_overrides_are_recorded_and_rerun_the_results(tmp_path):
+    """Settings given over the case file's are stored (root `overrides`, `history`): the
+    stored case text with them re-runs to the same results; without them it does not."""
+    path = tmp_path / "over.nc"
+    tree = catdae.run(CASE, output=path, elements=6, rtol=1e-5)
+    back = catdae.read_results(path)
+    assert back.attrs["overrides"] == "rtol = 1e-05, elements = 6"
+    assert "with rtol = 1e-05, elements = 6 over the case file's" in back.attrs["history"]
+    again = catdae.run(back.attrs["case_toml"], elements=6, rtol=1e-5)
+    assert np.array_equal(again["tapped"].ds.position.values, tree["tapped"].ds.position.values)
+    assert catdae.run(back.attrs["case_toml"])["first"].ds.sizes["element"] == 4
+    assert "overrides" not in catdae.run(CASE).attrs  # none given: none stored
+
+
+def test_read_results_refuses_what_catdae_did_not_write(tmp_path):
+    from catdae.errors import ResultsError
+
+    with pytest.raises(ResultsError, match="no such file"):
+        catdae.read_results(tmp_path / "nope.nc")
+    (tmp_path / "text.nc").write_text("not netCDF")
+    with pytest.raises(ResultsError, match="not a readable netCDF-4 results file"):
+        catdae.read_results(tmp_path / "text.nc")
+    import xarray as xr
+
+    xr.Dataset({"x": ("t", [1.0, 2.0])}).to_netcdf(tmp_path / "foreign.nc")
+    with pytest.raises(ResultsError, match="no step results"):
+        catdae.read_results(tmp_path / "foreign.nc")
