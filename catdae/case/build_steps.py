@@ -146,6 +146,11 @@ class StepsPass:
             if nm in names:
                 self.problem(where + ("name",), f"duplicate step name {nm!r} (also "
                              f"steps[{names[nm]}])")
+            elif len(nm.encode()) > MAX_STEP_BYTES:
+                self.problem(where + ("name",), f"a step name of {len(nm.encode())} bytes in "
+                             f"UTF-8, above the limit of {MAX_STEP_BYTES}: it names files too "
+                             "(figures, VTK series: at most 255 bytes a file name), found "
+                             f"{shorten(nm)}")
             elif not _group_name(nm):
                 self.problem(where + ("name",), "a step name names a group of the results "
                              "file: expected a letter, digit or '_' first, then also '.', '-', "
@@ -331,6 +336,7 @@ class StepsPass:
 
 
 _GROUP_NAME = re.compile(r"\w[\w.+\-@ ]*")
+MAX_STEP_BYTES = 200  # a step name in UTF-8: <step>-sweep<k>-<what>.png within 255 bytes
 
 
 def _group_name(name: str) -> bool:

@@ -209,6 +209,14 @@ def test_unsafe_step_names_are_refused(tmp_path, capsys):
                 "of the results file", tmp_path, capsys, subprocess_check=k == 0)
 
 
+def test_step_names_that_would_overflow_a_file_name_are_refused(tmp_path, capsys):
+    """85 CJK characters are within the 100-character limit of names but 255 bytes in UTF-8:
+    the figures and VTK series named after the step could not be written (a tester's exit 1
+    after the run); refused before it, with the reason."""
+    invalid(scene(steps=static_step("電" * 85)), "steps[0].name", "a step name of 255 bytes "
+            "in UTF-8, above the limit of 200", tmp_path, capsys, subprocess_check=False)
+
+
 def test_safe_step_names_are_written_as_given(tmp_path):
     names = ["équilibre", "ok-1", "a.b", "_x", "2nd step"]
     tree = valid(scene(steps="".join(static_step(n) for n in names)), tmp_path)
