@@ -51,6 +51,9 @@ def as_case(case_or_path: Case | str | os.PathLike) -> Case:
     return case_or_path if isinstance(case_or_path, Case) else load_case(case_or_path)
 
 
+OVERRIDES = ("rtol", "atol", "elements", "mass_model", "max_order")  # Case.with_overrides
+
+
 def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | None = None,
         progress: bool | None = None, on_group: Callable[[str, xr.Dataset], None] | None = None,
         **overrides) -> xr.DataTree:
@@ -62,6 +65,11 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
     holds the tree computed so far (status says why); with ``output`` that partial tree is
     written too, never over an existing file (it goes to ``<output stem>.failed.nc`` then).
     """
+    unknown = sorted(set(overrides) - set(OVERRIDES))
+    if unknown:
+        raise TypeError(f"catdae.run() got an unexpected keyword argument {unknown[0]!r}; it "
+                        f"takes output, progress, on_group and the overrides "
+                        f"{', '.join(OVERRIDES)}")
     case = as_case(case_or_path)
     ov = {k: v for k, v in overrides.items() if v is not None}
     if ov:

@@ -367,3 +367,9 @@ def test_read_results_refuses_what_catdae_did_not_write(tmp_path):
     xr.Dataset({"x": ("t", [1.0, 2.0])}).to_netcdf(tmp_path / "foreign.nc")
     with pytest.raises(ResultsError, match="no step results"):
         catdae.read_results(tmp_path / "foreign.nc")
+
+
+def test_an_unknown_keyword_of_run_names_run_and_what_it_takes():
+    with pytest.raises(TypeError, match=r"catdae.run\(\) got an unexpected keyword argument "
+                       r"'foo'; it takes output, progress, on_group and the overrides rtol"):
+        catdae.run(CASE, foo=1)
