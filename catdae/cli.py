@@ -270,6 +270,8 @@ def _step_lines(name: str, ds) -> list[str]:
         lines.append(f"[{name}] static{hot}: {ds.attrs.get('iterations')} Newton "
                      f"iterations, residual {ds.attrs.get('residual_norm', 0):.2e} N")
         lines.extend(_cable_lines(ds))
+        if ds.attrs.get("note"):
+            lines.append(f"    note: {ds.attrs['note']}")
     elif kind == "modal":
         lines.extend(_mode_lines(name, ds))
     elif kind == "transient":

@@ -300,3 +300,15 @@ def test_a_short_smooth_ramp_runs_without_nan(tmp_path):
     for name in ("position", "velocity", "acceleration", "tension"):
         assert np.isfinite(ds[name].values).all(), name
     assert np.isfinite(ds.reaction.sel(node=["A", "B"]).values).all()
+
+
+def test_a_static_state_stretched_far_beyond_a_cable_is_noted(tmp_path):
+    """A 1e9 N load on a cable of EA 1e7 passes the case check (loads are not bounded) and
+    solves to a strain of 50 (an independent tester's case, 1e12 N, took 53 s): the step's
+    note says the strain, the element and what to check; an ordinary load gets none."""
+    text = scene(EA=1e7).replace("[[steps]]", '[[loads]]\nname = "P"\nnode = "c.2"\n'
+                           "force = [0.0, 0.0, {f}]\n[[steps]]", 1)
+    for force, noted in ((-1e9, True), (-100.0, False)):
+        ds = valid(text.replace("{f}", repr(force)), tmp_path)
+        step = next(iter(ds.children.values())).to_dataset()
+        assert ("far beyond what a cable carries" in step.attrs.get("note", "")) == noted
