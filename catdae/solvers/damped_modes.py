@@ -135,5 +135,6 @@ def solve_damped(model: Model, X: np.ndarray, state: ElementState, n_modes: int,
     m = m[free][:, free]
     modes = solve_quadratic(k, c[free][:, free], m, min(int(n_modes), free.size))
     shapes = np.zeros((modes.s.size, model.n_dof), complex)
-    shapes[:, free] = modes.shape
-    return modes, shapes.reshape(modes.s.size, -1, 3)
+    if modes.s.size:  # none found underdamped: every mode NaN (with_damped_modes pads)
+        shapes[:, free] = modes.shape
+    return modes, shapes.reshape(modes.s.size, model.mesh.n_nodes, 3)

@@ -144,3 +144,17 @@ def test_a_study_of_a_swept_step_is_refused_before_any_run(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"{case}: steps[1].sweep: the study step 'modes' is swept" in err, err
     assert not (tmp_path / "s.nc").exists()
+
+
+def test_a_damped_modal_step_whose_every_mode_is_overdamped_is_written():
+    """The weight on its spring and damper (k 1000 N/m, m 4 kg) swept over c: below
+    c = 2 sqrt(k m) = 126.5 N s/m the mode has ζ = c / (2 sqrt(k m)); at 400 N s/m (ζ 1.58)
+    none is underdamped and the mode is NaN with its label (a tester's run crashed there, with
+    a traceback and nothing written)."""
+    text = SPRING + step("static", "st") + step(
+        "modal", "modes", modes=1, sweep={"field": "dampers.d.coefficient",
+                                          "values": [10.0, 400.0]})
+    md = catdae.run(case_from_dict(tomllib.loads(text)))["modes"].ds
+    zeta = md.damping_ratio.sel(mode=1).values
+    assert zeta[0] == pytest.approx(10.0 / (2 * np.sqrt(1000.0 * 4.0)), rel=1e-10)
+    assert np.isnan(zeta[1]) and np.isnan(md.frequency.sel(mode=1).values[1])
