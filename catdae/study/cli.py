@@ -28,7 +28,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--gauss-points", type=int, nargs="+")
     p.add_argument("--mass-model", nargs="+", choices=CHOICES["mass_model"])
     p.add_argument("--linear-solver", nargs="+", choices=CHOICES["linear_solver"])
-    p.add_argument("--max-order", type=int, nargs="+")
+    p.add_argument("--max-order", type=_order, nargs="+", metavar="{auto,1-5}")
     p.add_argument("--response", help="transient: a case node, <cable>@<p/q> or <cable>.<k> of "
                    "the case file's mesh (default: the common node moving most); modal: how "
                    "many of the lowest frequencies are compared, or frequency:<k> for mode k; "
@@ -170,3 +170,13 @@ def _interrupted(exc: KeyboardInterrupt, out: Path | None, store: Path | None) -
     if store is not None:
         print(f"catdae study: finished runs are kept in {store}", file=sys.stderr)
     return code
+
+
+def _order(text: str) -> int | str:
+    """A --max-order value: "auto" (the default of a transient step) or an integer."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}") from None

@@ -288,3 +288,14 @@ def test_peak_tension_error_shrinks_as_the_tolerance_tightens():
     given = run_study(text, reference=catdae.run(ref_case), **kw)
     np.testing.assert_allclose(given.peak_tension_error.values, ds.peak_tension_error.values,
                                rtol=1e-9)
+
+
+def test_the_command_line_takes_max_order_auto():
+    """`--max-order auto 5`: the default against a fixed order (a tester's 'invalid int')."""
+    from catdae.study.cli import _order
+
+    assert [_order(x) for x in ("auto", "5")] == ["auto", 5]
+    import argparse
+
+    with pytest.raises(argparse.ArgumentTypeError, match="expected auto or 1-5"):
+        _order("fast")
