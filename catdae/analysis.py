@@ -236,7 +236,7 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress,
         return _static_step(step, model, state)
     if step.kind == "modal":
         if settle or step.add or step.remove or step.temperature_change is not None:
-            its = _static_step(step, model, state).attrs["iterations"]
+            its = _static_solve(step, model, state)[0].iterations
             return _modal_step(step, model, state).assign_attrs(equilibrium=(
                 f"found again for the step's own scene ({its} Newton iterations)"))
         return _modal_step(step, model, state)
@@ -268,16 +268,31 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
     return found, mesh, model, _static_result(model, state, sol)
 
 
-def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
+def _static_solve(step: Step, model: Model, state: _State):
+    """The static equilibrium of the step's scene from the current state, which it becomes
+    (at rest). Returns (solution, the model whose tensions it holds, the seabed summary or
+    None)."""
+    summary = None
     if model.case.seabed is not None:  # docs/theory.md §17
-        from catdae.output.seabed import add_seabed
         from catdae.solvers.seabed_static import solve_static_on_seabed
 
         sol, model, summary = solve_static_on_seabed(model, state.X, state.h, t=state.t,
                                                      load_steps=step.load_steps)
-        return add_seabed(_static_result(model, state, sol), model.mesh, summary)
-    sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
-    return _static_result(model, state, sol)
+    else:
+        sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
+    state.X, state.h = sol.X, sol.state.h
+    state.V = np.zeros_like(sol.X)
+    return sol, model, summary
+
+
+def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
+    sol, model, summary = _static_solve(step, model, state)
+    ds = _static_result(model, state, sol)
+    if summary is None:
+        return ds
+    from catdae.output.seabed import add_seabed
+
+    return add_seabed(ds, model.mesh, summary)
 
 
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:

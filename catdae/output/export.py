@@ -177,8 +177,9 @@ def write_vtk(tree: xr.DataTree, folder: str | os.PathLike, steps=None) -> list[
 
     written = []
     for group in names:  # a swept step: a series per value, <step>-sweep<k>
-        if (why := step_problem(tree[group].to_dataset())) is not None:
+        full = tree[group].to_dataset()
+        if (why := step_problem(full)) is not None:
             raise ExportError(f"step {group[:60]!r}: {why}")
         written += [write_step(ds, folder, name, case)
-                    for name, ds in step_values(group, tree[group].to_dataset())]
+                    for name, ds in step_values(group, full)]
     return written

@@ -367,9 +367,10 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
     written = []
     from catdae.output.reading import step_problem, step_values
     for group in names:  # a swept step: a figure per value, <step>-sweep<k>-<what>.png
-        if (why := step_problem(tree[group].to_dataset())) is not None:
+        full = tree[group].to_dataset()
+        if (why := step_problem(full)) is not None:
             raise PlotError(f"step {group[:60]!r}: {why}")
-        for name, ds in step_values(group, tree[group].to_dataset()):
+        for name, ds in step_values(group, full):
             can = _CAN.get(ds.attrs.get("kind"), ())
             for w in (w for w in wanted if w in can):
                 path = folder / f"{name}-{w}.png"
