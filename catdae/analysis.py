@@ -239,6 +239,13 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress,
             its = _static_solve(step, model, state)[0].iterations
             return _modal_step(step, model, state).assign_attrs(equilibrium=(
                 f"found again for the step's own scene ({its} Newton iterations)"))
+        speed = float(np.sqrt((state.V**2).sum(axis=1)).max(initial=0.0))
+        if speed > 1e-6:  # after a transient: the state it ended in, moving
+            moving = (f"not an equilibrium: the modes linearise the state the previous step "
+                      f"ended in, its nodes moving at up to {speed:.3g} m/s; a static step "
+                      "before this one gives the modes about equilibrium")
+            return _modal_step(step, model, state).assign_attrs(equilibrium=moving,
+                                                                note=moving)
         return _modal_step(step, model, state)
     from catdae.solvers.transient import run_transient  # the only module that imports sksundae
 

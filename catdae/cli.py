@@ -274,6 +274,8 @@ def _step_lines(name: str, ds) -> list[str]:
             lines.append(f"    note: {ds.attrs['note']}")
     elif kind == "modal":
         lines.extend(_mode_lines(name, ds))
+        if ds.attrs.get("note"):
+            lines.append(f"    note: {ds.attrs['note']}")
     elif kind == "transient":
         a = ds.attrs
         lines.append(f"[{name}] transient: {ds.time.size} outputs to t = "
