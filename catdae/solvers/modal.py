@@ -91,13 +91,19 @@ def _reciprocal(k: np.ndarray, m: np.ndarray, n_modes: int) -> tuple[np.ndarray,
     return 1.0 / mu[sel], vec[:, sel]
 
 
+SYMMETRY_SHARE = 0.9  # of a shape's squares, in its symmetric or antisymmetric part, to say so
+
+
 def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str], list[str]]:
     """Label the modes of a single-span cable: in-plane/out-of-plane, symmetric/antisymmetric.
 
     The plane is the vertical plane through the chord; a mode is out-of-plane when most of its
     nodal motion (sum of squares over the nodes) is normal to it. Symmetry is read from the
-    mirror image about midspan (node k <-> node n-k along the cable). Scenes with several
-    cables, or a vertical chord, are labelled "unclassified".
+    mirror image about the cable's middle (the shape at unstrained arc length L - s against
+    that at s, interpolated between nodes): "symmetric" or "antisymmetric" when that part is
+    at least SYMMETRY_SHARE of the shape, else "mixed" (a scene that is not symmetric, such as
+    a mass off midspan, mixes the two). Scenes with several cables, or a vertical chord, are
+    labelled "unclassified".
     """
     mesh = model.mesh
     n = shapes.shape[0]
@@ -111,6 +117,12 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
     e1 = horiz / np.linalg.norm(horiz)  # along the span
     e3 = np.array([0.0, 0.0, 1.0])
     e2 = np.cross(e3, e1)  # normal to the cable plane
+    s_along = mesh.s_node[order]
+    s_mirror = s_along[0] + s_along[-1] - s_along
+
+    def mirrored(a):  # the component at the mirror point of every node
+        return np.interp(s_mirror, s_along, a)
+
     plane, sym = [], []
     for i in range(n):
         u = shapes[i, order]  # (n_along, 3)
@@ -121,10 +133,15 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
         plane.append("in-plane" if in_plane else "out-of-plane")
         # mirror about midspan: along-span component changes sign, the others keep theirs
         if in_plane:
-            s_part = np.sum((a3 + a3[::-1]) ** 2) + np.sum((a1 - a1[::-1]) ** 2)
-            a_part = np.sum((a3 - a3[::-1]) ** 2) + np.sum((a1 + a1[::-1]) ** 2)
+            m1, m3 = mirrored(a1), mirrored(a3)
+            s_part = np.sum((a3 + m3) ** 2) + np.sum((a1 - m1) ** 2)
+            a_part = np.sum((a3 - m3) ** 2) + np.sum((a1 + m1) ** 2)
         else:
-            s_part = np.sum((out + out[::-1]) ** 2)
-            a_part = np.sum((out - out[::-1]) ** 2)
-        sym.append("symmetric" if s_part >= a_part else "antisymmetric")
+            mo = mirrored(out)
+            s_part = np.sum((out + mo) ** 2)
+            a_part = np.sum((out - mo) ** 2)
+        total = s_part + a_part
+        share = max(s_part, a_part) / total if total > 0 else 1.0
+        sym.append("mixed" if share < SYMMETRY_SHARE else
+                   "symmetric" if s_part >= a_part else "antisymmetric")
     return plane, sym
