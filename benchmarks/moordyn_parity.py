@@ -50,9 +50,11 @@ CATDAE_PENDULUM = {
     # over the 50th period, MoorDyn's RK4 -0.42 %); a tenth of the rtol keeps it below
     "rtol 1e-5, atol 1e-4": "rtol = 1e-5\natol = 1e-4",
 }
-MOORDYN_PENDULUM = {  # label: (segments, BA/-zeta as a positive ratio)
-    "10 segments, BA/-zeta -0.01 (its test file)": (10, 0.01),
-    "10 segments, no internal damping": (10, 0.0),
+MOORDYN_PENDULUM = {  # label: (segments, BA/-zeta as a positive ratio, cfl)
+    "10 segments, BA/-zeta -0.01 (its test file)": (10, 0.01, 0.1),
+    "10 segments, no internal damping": (10, 0.0, 0.1),
+    # its largest stable step (session 14: cfl 0.25, 0.3, 0.35, 0.4 and above fail to integrate)
+    "10 segments, BA/-zeta -0.01, cfl 0.2 (largest stable)": (10, 0.01, 0.2),
 }
 CATDAE_VIOLENT = {
     "rtol 5e-3, atol 1e-4, max_order 2 (README snap settings)": (
@@ -102,9 +104,10 @@ def pendulum(folder: Path, repeats: int, periods: float = 5) -> list[str]:
         f = ringing.pendulum_figures(ds, periods)
         cat.append((label, f, wall, cpu, int(ds.attrs.get("n_steps", 0)),
                     float(ds.attrs["wall_time"])))
-    for label, (seg, zeta) in MOORDYN_PENDULUM.items():
+    for label, (seg, zeta, cfl) in MOORDYN_PENDULUM.items():
         f, wall, cpu = median_runs(
-            lambda s=seg, z=zeta: moordyn_process(f"pendulum({s}, {z}, periods={periods!r})"),
+            lambda s=seg, z=zeta, c=cfl: moordyn_process(
+                f"pendulum({s}, {z}, cfl={c!r}, periods={periods!r})"),
             repeats)
         md.append((label, f, wall, cpu, f["cpu_init"] + f["cpu_steps"]))
     rows = [f"| pendulum run ({periods:g} periods; catdae {duration:g} s) | period error | "

@@ -660,7 +660,8 @@ def test_symmetry_labels_of_a_string_with_a_mass_off_midspan_follow_the_closed_f
     x = np.linspace(0.0, L, 2001)
     checked = 0
     for k in roots[:3]:
-        u = np.where(x <= a, np.sin(k * x) / np.sin(k * a), np.sin(k * (L - x)) / np.sin(k * (L - a)))
+        u = np.where(x <= a, np.sin(k * x) / np.sin(k * a),
+                     np.sin(k * (L - x)) / np.sin(k * (L - a)))
         sym, anti = np.sum((u + u[::-1]) ** 2), np.sum((u - u[::-1]) ** 2)
         share = max(sym, anti) / (sym + anti)
         expected = ("mixed" if share < 0.9 else "symmetric" if sym > anti else "antisymmetric")
