@@ -68,7 +68,9 @@ def _reference_arg(items: list[str] | None):
         from catdae.output.results import read_tree
 
         try:
-            return read_tree(items[0])
+            tree = read_tree(items[0])
+            tree.attrs["reference_file"] = str(items[0])  # named in the study's attrs
+            return tree
         except (OSError, ValueError) as exc:
             raise StudyError(f"reference: cannot read {items[0]!r}: {exc}") from None
     out: dict[str, Any] = {}

@@ -80,7 +80,7 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         raise StudyError(f"a setting of the study makes the case invalid:\n{exc}") from None
     MemoryProbe(memory)  # reject an unknown method before anything runs
     keys = [run_key(c, st.name, memory) for c in run_cases]
-    ref_data = _given_reference(reference, st, case) if given_ref else None
+    ref_data = _given_reference(reference, st, case, duration) if given_ref else None
     if st.kind == "transient":
         given_points = set(ref_data.point.values) if given_ref else None
         target = _transient_target(case, run_cases + ([ref_case] if ref_case else []), response,
@@ -133,7 +133,9 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
         "Conventions": "CF-1.10",
     }))
     if given_ref:
-        out.attrs["reference"] = "given by the user"
+        source = reference.attrs.get("reference_file")
+        out.attrs["reference"] = (f"given by the user: {source}" if source
+                                  else "given by the user")
     else:
         out.attrs["reference"] = ", ".join(f"{k}={v}" for k, v in ref_settings.items())
         out.attrs.update({f"reference_{k}": v for k, v in ref_settings.items()})
@@ -184,13 +186,28 @@ def _modal_target(st: Step, response) -> int:
     return n
 
 
-def _given_reference(reference, st: Step, case: Case) -> xr.Dataset:
-    """A user's reference results (a step group, or a tree holding it) in the stored form."""
+def _given_reference(reference, st: Step, case: Case, duration=None) -> xr.Dataset:
+    """A user's reference results (a step group, or a tree holding it) in the stored form. A
+    transient reference must cover the study's step: its errors are measured at the
+    reference's output times, and a shorter one would leave the rest of the step unmeasured."""
     ds = reference
+    where = reference.attrs.get("reference_file")
+    where = f"reference {where!r}" if where else "reference"
     if isinstance(ds, xr.DataTree):
         if st.name not in ds.children:
-            raise StudyError(f"reference: the results have no group {st.name!r}")
+            raise StudyError(f"{where}: the results have no group {st.name!r}")
         ds = ds[st.name].to_dataset()
+    if st.kind == "transient" and "time" in ds.coords and ds.time.size:
+        t0 = sum(s.duration for s in case.steps[:case.steps.index(st)]
+                 if s.kind == "transient")
+        t_end = t0 + (duration if duration is not None else st.duration)
+        tol = 1e-9 * max(abs(t_end), 1.0)
+        t_first, t_last = float(ds.time[0]), float(ds.time[-1])
+        if t_first > t0 + tol or t_last < t_end - tol:
+            raise StudyError(
+                f"{where}: step {st.name!r} holds t = {t_first:.6g} to {t_last:.6g} s; the "
+                f"study's step runs from {t0:.6g} to {t_end:.6g} s: give a reference that "
+                "covers it, or shorten the study with --duration")
     attrs = {"status": str(ds.attrs.get("status", "completed")), "wall_time": math.nan}
     if st.kind == "static":
         return static_values(ds, attrs)
@@ -198,10 +215,10 @@ def _given_reference(reference, st: Step, case: Case) -> xr.Dataset:
         attrs["peak_tension"] = peak_tension(ds)
     if st.kind == "modal":
         if "frequency" not in ds:
-            raise StudyError("reference: a modal study needs a 'frequency' variable")
+            raise StudyError(f"{where}: a modal study needs a 'frequency' variable")
         return xr.Dataset({"frequency": ("mode", ds.frequency.values)}, attrs=attrs)
     if "displacement" not in ds:
-        raise StudyError("reference: a transient study needs a 'displacement' variable")
+        raise StudyError(f"{where}: a transient study needs a 'displacement' variable")
     names = [str(n) for n in ds.node.values]
     counts: dict[str, int] = {}
     for n in names:

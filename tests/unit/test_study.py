@@ -221,6 +221,27 @@ def test_a_given_reference_gives_the_automatic_errors():
     np.testing.assert_allclose(given.error.values, auto.error.values, rtol=1e-12)
 
 
+def test_a_given_reference_must_cover_the_step_and_is_named(tmp_path, capsys):
+    """A transient reference shorter than the study's step was taken silently (the errors then
+    measured its first part alone), and the study did not say which file it was."""
+    kw = dict(rtol=[1e-3], atol=[1e-10], elements=[4], scheduler="synchronous")
+    ref_settings = {"rtol": 1e-6, "atol": 1e-10, "elements": 4}
+    base = load_case(GENTLE)
+    short = catdae.run(study.configure(base, "excitation", ref_settings, duration=0.05))
+    with pytest.raises(StudyError, match=r"holds t = 0 to 0.05 s.*runs from 0 to 0.1 s"):
+        run_study(GENTLE, reference=short, duration=0.1, **kw)
+    ref_file = tmp_path / "ref.nc"
+    catdae.run(study.configure(base, "excitation", ref_settings, duration=0.1), output=ref_file)
+    args = [str(GENTLE), "--rtol", "1e-3", "--atol", "1e-10", "--elements", "4",
+            "--scheduler", "synchronous", "--reference", str(ref_file), "-o"]
+    assert study.main([*args, str(tmp_path / "a.nc"), "--duration", "0.2"]) == 2
+    assert f"reference '{ref_file}'" in capsys.readouterr().err
+    assert study.main([*args, str(tmp_path / "b.nc"), "--duration", "0.1"]) == 0
+    ds = xr.load_dataset(tmp_path / "b.nc")
+    assert ds.attrs["reference"] == f"given by the user: {ref_file}"
+    assert np.isfinite(ds.error.values).all()
+
+
 def test_grids_without_a_common_node_are_rejected():
     # example 2's named nodes are both pinned supports: only mesh nodes can be compared, and
     # meshes of 5 and 8 elements share none.
