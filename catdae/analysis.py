@@ -21,7 +21,7 @@ from catdae.case.frame import rotate_back, to_gravity_frame
 from catdae.case.sweep import apply_sweep
 from catdae.case.sweep import units as sweep_units
 from catdae.element.elements import NOT_CONVERGED
-from catdae.errors import CaseError, CatdaeError, ConvergenceError, OutOfMemory
+from catdae.errors import CaseError, CatdaeError, ConvergenceError, InternalError, OutOfMemory
 from catdae.model import formfind
 from catdae.model.assembly import Model
 from catdae.model.mesh import build_mesh
@@ -131,6 +131,11 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
             status = f"failed in step '{step.name}': {exc}"
             writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
+        except Exception as exc:  # a bug: the step fails, what was computed is kept
+            err = InternalError.in_step(step.name, exc)
+            status = f"failed in step '{step.name}': {err}"
+            writer.keep_failed(err, results.make_tree(case, groups, status=status))
+            raise err from exc
         groups[step.name] = ds
         if on_group is not None:
             on_group(step.name, ds)
@@ -164,6 +169,7 @@ def check_steps(case: Case, mesh) -> None:
     if case.steps and case.steps[0].sweep is not None and formfind.pending(case):
         problems.append(("steps[0].sweep", "the first static step finds the cables' lengths "
                          "(form-finding) and cannot be swept; sweep a later step"))
+    problems += _damper_only_nodes(case, mesh)
     absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
               if not x.active}
     for i, step in enumerate(case.steps):
@@ -182,6 +188,30 @@ def check_steps(case: Case, mesh) -> None:
                              "cable's material a mass > 0 or put a point mass there"))
     if problems:
         raise CaseError(case.path, problems)
+
+
+def _damper_only_nodes(case: Case, mesh) -> list[tuple[str, str]]:
+    """Free nodes that dampers reach but nothing stiff (no cable element, spring or bar):
+    without stiffness they have no static equilibrium (the modal step then failed with "not
+    stable", naming nothing)."""
+    if not case.dampers:
+        return []
+    model = Model(case, mesh, set())
+    cn = model.connectors
+    stiff = np.zeros(mesh.n_nodes, bool)
+    stiff[mesh.conn.ravel()] = True
+    held = np.array([kind != "damper" and k > 0 for kind, k in zip(cn.kinds, cn.stiffness,
+                                                                   strict=True)], bool)
+    stiff[cn.ends[held].ravel()] = True
+    free = ~model.fixed_mask.all(axis=1)
+    out = []
+    for i, d in enumerate(case.dampers):
+        loose = [e for e in d.ends if free[mesh.node_index(e)] and not stiff[mesh.node_index(e)]]
+        out += [(f"dampers[{i}].ends", f"node {e!r} is held by the damper alone (no cable, "
+                 "spring or bar reaches it, and it is not a support): a damper has no "
+                 "stiffness, so the node has no static equilibrium; support it, or join it "
+                 "with a spring or a bar") for e in loose]
+    return out
 
 
 def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, state: _State,

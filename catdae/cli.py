@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
+import traceback
 from importlib.resources import files
 from pathlib import Path
 
@@ -20,7 +21,7 @@ import numpy as np
 
 from catdae._version import __version__
 from catdae.case.schema import MASS_MODEL_NAMES
-from catdae.errors import CaseError, CatdaeError, OutputError, ResultsError
+from catdae.errors import CaseError, CatdaeError, InternalError, OutputError, ResultsError
 from catdae.interrupts import signals_as_interrupts
 from catdae.output.files import check_folder
 from catdae.output.reading import step_values
@@ -184,6 +185,8 @@ def _run(args) -> int:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:
         print(f"catdae: {path}: {exc}", file=sys.stderr)
+        if isinstance(exc, InternalError) and exc.__cause__ is not None:  # for the report
+            traceback.print_exception(exc.__cause__, file=sys.stderr)
         _say_where(exc, "before the failure")
         return 1
     say(summary(tree))
@@ -312,8 +315,11 @@ def _mode_lines(name: str, ds) -> list[str]:
         line = (f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
                 + (f", {labels}" if labels else ""))
         if damped:
-            line += (f", damping ratio {float(ds.damping_ratio.values[k]):.4g} (undamped "
-                     f"{float(ds.undamped_frequency.values[k]):.6g} Hz)")
+            line += f", damping ratio {float(ds.damping_ratio.values[k]):.4g}"
+            like = int(ds.undamped_mode.values[k]) if "undamped_mode" in ds else k + 1
+            if like >= 1:  # the undamped mode it is most like, not the k-th (sorted by |s|)
+                f_u = float(ds.undamped_frequency.sel(mode=like))
+                line += f" (like undamped mode {like}: {f_u:.6g} Hz)"
         out.append(line)
     return out
 

@@ -55,6 +55,16 @@ class OutOfMemory(CatdaeError):
                    "fewer outputs or fewer modes")
 
 
+class InternalError(CatdaeError):
+    """An unexpected exception inside a step (a bug in catdae): the step fails like any other,
+    what the steps before it computed is kept, and the original exception is the cause."""
+
+    @classmethod
+    def in_step(cls, name: str, exc: Exception) -> InternalError:
+        return cls(f"internal error in step '{name}' ({type(exc).__name__}: {exc}); this is a "
+                   "bug in catdae: please report it with the case file")
+
+
 class ResultsError(CatdaeError):
     """A results file that cannot be read: missing, empty, truncated, corrupted, or not one
     that catdae wrote (bad input to ``catdae plot`` and ``export``: exit 2)."""

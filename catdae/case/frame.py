@@ -135,11 +135,22 @@ def rotate_back(ds, R: np.ndarray | None):
             g = np.where(nan, 0.0, v) @ R
             if nan.any():
                 g[(nan.astype(float) @ (np.abs(R) > _TOL)) > 0] = np.nan
-            if name == "shape":  # (mode, node, axis): the largest component +1 again
-                flat = g.reshape(g.shape[0], -1)
-                g = g / flat[np.arange(flat.shape[0]), np.nanargmax(np.abs(flat), axis=1)][
-                    :, None, None]
+            if name == "shape":  # (..., mode, node, axis): the largest component +1 again
+                g = _largest_one(g)
+            elif name == "complex_shape":  # (..., mode, part, node, axis), part = real, imag
+                z = _largest_one(g[..., 0, :, :] + 1j * g[..., 1, :, :])
+                g = np.stack([z.real, z.imag], axis=-3)
             out[name] = var.copy(data=g)
     if "axis" in out.coords:
         out.coords["axis"].attrs["long_name"] = "axis of the case (gravity along the group's -up)"
     return out
+
+
+def _largest_one(g: np.ndarray) -> np.ndarray:
+    """Shapes (..., node, axis), real or complex, each divided by its component of largest
+    modulus (a sweep adds leading dimensions); a shape of NaN (a mode not found) stays NaN."""
+    flat = g.reshape(-1, g.shape[-2] * g.shape[-1])
+    mag = np.where(np.isnan(flat), -1.0, np.abs(flat))
+    big = flat[np.arange(flat.shape[0]), np.argmax(mag, axis=1)]
+    big = np.where((big == 0) | np.isnan(big), 1.0, big)
+    return (flat / big[:, None]).reshape(g.shape)

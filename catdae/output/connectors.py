@@ -36,6 +36,22 @@ def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
     )
 
 
+def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarray:
+    """For each damped mode (complex shapes (k, n_nodes, 3)), the number (from 1) of the
+    undamped mode (real shapes (n, n_nodes, 3)) of largest modal assurance criterion
+    |uᵀ φ|² / (|u|² |φ|²); 0 beyond the k found. Damped modes are sorted by |s| and the
+    overdamped ones dropped, so the k-th damped mode need not be the k-th undamped one."""
+    out = np.zeros(n, dtype=np.int32)
+    u = np.nan_to_num(undamped.reshape(undamped.shape[0], -1))
+    d = np.nan_to_num(damped.reshape(damped.shape[0], -1))[:n]
+    if d.size and u.size:
+        num = np.abs(d.conj() @ u.T) ** 2
+        den = np.outer(np.einsum("ij,ij->i", d.conj(), d).real, np.einsum("ij,ij->i", u, u))
+        mac = num / np.where(den > 0, den, 1.0)
+        out[:d.shape[0]] = np.argmax(mac, axis=1) + 1
+    return out
+
+
 def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
                       ) -> xr.Dataset:
     """The damped modes of a modal step beside its undamped results: ``frequency`` becomes the
@@ -53,6 +69,9 @@ def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
     shape = pad(np.stack([shapes.real, shapes.imag], axis=1))  # (n, 2, n_nodes, 3)
     labels = ["overdamped or not found"] * n
     return ds.assign(
+        undamped_mode=var("mode", like_undamped(ds["shape"].values, shapes, n), "1",
+                          "number of the undamped mode the damped mode is most like (MAC); "
+                          "0: not found"),
         undamped_frequency=ds["frequency"].assign_attrs(
             long_name="natural frequency of the undamped system"),
         frequency=var("mode", pad(modes.frequency), "Hz",

@@ -145,6 +145,24 @@ def test_failed_analysis_exits_1_and_says_where_the_results_are(tmp_path, monkey
     assert "failed in step 'equilibrium'" in catdae.read_results(out).attrs["status"]
 
 
+def test_an_internal_error_keeps_the_steps_before_it(tmp_path, monkeypatch, capsys):
+    """A bug inside a step (here a ValueError put into the modal solver; a tester's was a
+    swept modal step under a gravity vector) lost every result with a raw traceback: the step
+    now fails as any other, exit 1, the static step kept and the status saying why."""
+    def broken(*args, **kwargs):
+        raise ValueError("operands could not be broadcast (test)")
+
+    monkeypatch.setattr(catdae.analysis, "solve_modal", broken)
+    out = tmp_path / "x.nc"
+    assert main(["run", str(THREE), "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "internal error in step 'modes' (ValueError: operands could not" in err
+    assert "bug in catdae" in err and str(out) in err
+    tree = catdae.read_results(out)
+    assert list(tree.children) == ["equilibrium"]
+    assert "failed in step 'modes': internal error" in tree.attrs["status"]
+
+
 def test_python_m_catdae_version():
     proc = subprocess.run([sys.executable, "-m", "catdae", "--version"], capture_output=True,
                           text=True, timeout=120)

@@ -174,6 +174,27 @@ def test_bad_connectors_get_a_located_message_and_exit_2(extra, field, words, tm
     assert not (tmp_path / "o.nc").exists()
 
 
+def test_a_node_held_by_a_damper_alone_is_refused_before_any_work(tmp_path, capsys):
+    """A tester's free node F joined to the cable by a damper only: the static step
+    "converged" and the modal step failed with "not stable", naming nothing. It has no
+    stiffness, so no equilibrium: refused at check (exit 2) naming the damper and the node;
+    a spring beside the damper makes the scene valid."""
+    from catdae.cli import main
+
+    def scene(extra):
+        return cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
+                           nodes={"F": (5.0, 2.0, -1.0)}, extra=extra,
+                           steps=static_step("st"))
+
+    f = tmp_path / "loose.toml"
+    f.write_text(scene(damper("d", ["c.2", "F"], 5.0)))
+    assert main(["check", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert f"{f}: dampers[0].ends: node 'F' is held by the damper alone" in err
+    f.write_text(scene(damper("d", ["c.2", "F"], 5.0) + spring("k", ["c.2", "F"], 100.0)))
+    assert main(["check", str(f)]) == 0
+
+
 def test_more_elements_keep_a_connector_on_its_mesh_node(tmp_path):
     """``elements`` overrides move an end on mesh node c.k to the same place of the new mesh,
     and refuse a count that puts it between mesh nodes."""

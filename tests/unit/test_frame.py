@@ -120,3 +120,74 @@ def test_a_case_already_in_the_frame_is_returned_as_it_is():
                                         elements=2, steps=static_step()))
     local, R = to_gravity_frame(case)
     assert R is None and local is case
+
+
+STAY_DAMPER = """
+{gravity}
+[materials.strand]
+EA = 2.55e9
+mass = 100.0
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [200.0, 0.0, 0.0]
+base = {base}
+[supports]
+A = "pinned"
+B = "pinned"
+base = "pinned"
+[[cables]]
+name = "stay"
+ends = ["A", "B"]
+material = "strand"
+length = 199.62
+elements = 20
+[[dampers]]
+name = "d"
+ends = ["stay.1", "base"]
+coefficient = 1.0e5
+[[steps]]
+kind = "static"
+name = "st"
+[[steps]]
+kind = "modal"
+name = "modes"
+modes = 4
+sweep = {{ field = "dampers.d.coefficient", values = [1.0e5, 3.0e5] }}
+"""
+
+
+def test_a_swept_modal_step_under_a_gravity_vector_is_the_upright_one_rotated():
+    """A tester's stay with a damper and a sweep of its coefficient under gravity = -y crashed
+    in rotate_back (swept shapes have one more dimension) and kept nothing. The same scene
+    turned upright by the rotation (x, y, z) -> (x, -z, y), which takes -y to -z, must give
+    the same frequencies and damping ratios, and the same shapes with the axes relabelled,
+    each scaled to a largest component of 1."""
+    tilted = catdae.run(STAY_DAMPER.format(gravity="gravity = [0.0, -9.81, 0.0]",
+                                           base="[10.0, 0.0, 1.0]"))["modes"].ds
+    upright = catdae.run(STAY_DAMPER.format(gravity="", base="[10.0, -1.0, 0.0]"))["modes"].ds
+    for name in ("frequency", "undamped_frequency", "damping_ratio", "undamped_mode"):
+        np.testing.assert_allclose(tilted[name].values, upright[name].values, rtol=1e-8)
+    perm = [0, 2, 1]  # the tilted frame's (x, y, z) are the upright (x, z, -y)
+    sign = np.array([1.0, 1.0, -1.0])
+
+    def scaled(v):  # each shape over its component of largest modulus
+        flat = v.reshape(-1, v.shape[-2] * v.shape[-1])
+        big = flat[np.arange(flat.shape[0]), np.argmax(np.abs(flat), axis=1)]
+        return (flat / big[:, None]).reshape(v.shape)
+
+    a = tilted.shape.values
+    np.testing.assert_allclose(a, scaled(upright.shape.values[..., perm] * sign), atol=1e-7)
+    zt = tilted.complex_shape.sel(part="real") + 1j * tilted.complex_shape.sel(part="imag")
+    zu = upright.complex_shape.sel(part="real") + 1j * upright.complex_shape.sel(part="imag")
+    np.testing.assert_allclose(zt.values, scaled(zu.values[..., perm] * sign), atol=1e-7)
+    largest = np.abs(zt).max(("node", "axis"))
+    np.testing.assert_allclose(largest.values, 1.0, rtol=1e-12)
+    assert (np.abs(tilted.shape).max(("node", "axis")).values == pytest.approx(1.0))
+    # damped modes are sorted by |s|: at 3e5 N s/m the in-plane mode comes first, and
+    # undamped_mode points each at the undamped mode of its own family (plane, symmetry)
+    for k in range(tilted.sizes["sweep"]):
+        one = tilted.isel(sweep=k)
+        like = one.undamped_mode.values - 1
+        assert (one.plane.values[like] == one.damped_plane.values).all()
+        assert (one.symmetry.values[like] == one.damped_symmetry.values).all()
+    assert list(tilted.undamped_mode.isel(sweep=1).values[:2]) == [2, 1]
