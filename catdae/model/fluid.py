@@ -241,6 +241,11 @@ class Fluid:
         """A current is given (uniform or a profile; its time function aside)."""
         return self.c_kind != NONE
 
+    @property
+    def has_flow(self) -> bool:
+        """A current or a wind is given (their time functions aside)."""
+        return self.c_kind != NONE or self.a_kind != NONE
+
     # ---------------------------------------------------------------------------- time
     def _factors(self, t: float, waves: bool):
         cf = self.current_factor * (1.0 if self.c_time is None else

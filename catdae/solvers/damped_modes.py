@@ -92,6 +92,21 @@ def _dense(x) -> np.ndarray:
     return x.toarray() if sp.issparse(x) else np.asarray(x, float)
 
 
+def fluid_flow(model: Model, X: np.ndarray):
+    """The fluid's linearisation about the line at rest in the steady flow of a static or
+    modal step (current and wind, no waves), (-∂f/∂x, -∂f/∂v) per element (n_elem, 6, 6);
+    None without a current or a wind (in still water the drag has no first-order term)."""
+    fl = model.fluid
+    if fl is None or not fl.has_flow:
+        return None
+    z = np.zeros(np.size(X))
+    _, _, kx, kv = fl.evaluate(fl.t, np.asarray(X, float).reshape(-1), z, z, want_jac=True,
+                               waves=False)
+    if not np.any(kv):
+        return None
+    return kx.copy(), kv.copy()
+
+
 def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
                    damping) -> sp.csr_matrix | None:
     """C on the full dof set about positions X: the dampers' c e eᵀ, and the step's ``damping``
@@ -99,9 +114,12 @@ def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
     α M + β K). None when the scene has no damping at all."""
     cn = model.connectors
     has_dampers = cn is not None and "damper" in cn.kinds  # (a sweep may start at c = 0)
-    if damping is None and not has_dampers:
+    flow = fluid_flow(model, X)
+    if damping is None and not has_dampers and flow is None:
         return None
     data = np.zeros(model.pattern.nnz)
+    if flow is not None:  # the drag on the relative velocity: -∂f/∂v (docs/theory.md §13.4)
+        data += model.pattern.assemble(flow[1])
     if has_dampers:
         data += model.pattern.assemble(
             extend(None, cn.damping_blocks(X), model.mesh.n_elements))
@@ -128,7 +146,11 @@ def solve_damped(model: Model, X: np.ndarray, state: ElementState, n_modes: int,
     if c is None:
         return None
     free = model.free
-    k = model.stiffness(state, X)[free][:, free]
+    k = model.stiffness(state, X)
+    flow = fluid_flow(model, X)
+    if flow is not None:  # the drag's stiffness in the flow, as the static Newton has it
+        k = k + model.pattern.matrix(model.pattern.assemble(flow[0]))
+    k = k[free][:, free]
     m = model.mass(state)
     if model.fluid is not None:  # the added mass of the water, as in the undamped modes
         m = m + model.pattern.matrix(model.pattern.assemble(model.fluid.mass(X)))
