@@ -5,8 +5,8 @@ derivatives. A scene without ``[water]`` and ``[air]`` has no :class:`Fluid` at 
 (``Model.fluid is None``) and pays nothing.
 
 Buoyancy is exact in statics where it can be: a cable that lies wholly below the still-water
-level (both ends below it, and heavier than the water it displaces) carries its submerged
-weight w - ρ g π d²/4 in the element itself (:func:`line_weight`, used by the mesh), so its
+level (both ends below it) carries its submerged weight w - ρ g π d²/4 (of either sign) in
+the element itself (:func:`line_weight`, used by the mesh), so its
 static nodes are those of the elastic catenary of the submerged weight. Other cables get their
 buoyancy on the part of each element's chord below the instantaneous surface, and parts of a
 submerged cable that a wave trough leaves in air lose theirs there; drag, added mass and the
@@ -46,20 +46,19 @@ def line_weight(case: Case, cable) -> float:
 
 def buoyancy_in_weight(case: Case, cable) -> bool:
     """Whether a whole cable lies in still water: water, a diameter, both ends at or below the
-    still-water level and a submerged weight >= 0 (the catenary then hangs below its chord)."""
+    still-water level (a buoyant cable too: its catenary then bulges above its chord)."""
     water = case.water
     mat = case.material_of(cable)
     if water is None or mat.diameter <= 0.0:
         return False
     ends = [case.nodes[n][2] for n in cable.ends]
-    wsub = mat.weight - water.density * case.gravity * _area(mat.diameter)
-    return max(ends) <= water.surface and wsub >= 0.0
+    return max(ends) <= water.surface
 
 
 def element_weights(case: Case, cable, z_nodes) -> tuple[np.ndarray, np.ndarray]:
     """(weight per unstrained metre (n,) N/m, whether it holds the buoyancy (n,) bool) of the n
     elements of a cable whose nodes are at heights ``z_nodes`` (n + 1,): the submerged weight
-    for an element with both nodes at or below the still-water level (and w - ρ g A >= 0), the
+    for an element with both nodes at or below the still-water level (of either sign), the
     weight in air otherwise (its buoyancy then comes from the Morison pass, docs/theory.md
     §13.1). A cable wholly in water holds its buoyancy in every element."""
     mat = case.material_of(cable)
@@ -72,7 +71,7 @@ def element_weights(case: Case, cable, z_nodes) -> tuple[np.ndarray, np.ndarray]
     if buoyancy_in_weight(case, cable):
         held = np.ones(n, bool)
     else:
-        held = (np.maximum(z[:-1], z[1:]) <= water.surface) & (wsub >= 0.0)
+        held = np.maximum(z[:-1], z[1:]) <= water.surface
     return np.where(held, wsub, mat.weight), held
 
 

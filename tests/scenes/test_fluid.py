@@ -60,6 +60,35 @@ def test_submerged_line_is_the_catenary_of_the_submerged_weight(ne):
     assert abs(air["h"][0] - ref["h"][0]) > 1e3 * 1e-9 * scale
 
 
+@pytest.mark.parametrize("ne", [1, 4, 10])
+def test_buoyant_submerged_line_is_the_mirrored_catenary(ne):
+    """A line lighter than the water it displaces (w - ρ g A < 0: a synthetic rope, a hose),
+    wholly under water, bulges up: its static state is the mirror image (z -> -z) of the
+    elastic catenary of |w - ρ g A| between the mirrored supports, at any mesh (a tester's
+    taut rope was +7.2 % in tension at 10 elements when its buoyancy came at Gauss points)."""
+    A, B = (0.0, 0.0, -300.0), (100.0, 20.0, -260.0)
+    L0, EA, mass, d = 110.0, 1.0e7, 7.15, 0.10
+    text = cable_scene(A=A, B=B, L0=L0, EA=EA, mass=mass, elements=ne,
+                       extra=_water().replace("depth = 200.0", "depth = 400.0"),
+                       steps=static_step())
+    text = text.replace(f"mass = {mass}\n", f"mass = {mass}\ndiameter = {d}\n")
+    ds = catdae.run(load_case(text))["st"].to_dataset()
+    w_sub = mass * G - RHO * G * math.pi * d * d / 4.0
+    assert w_sub < -8.0
+    flip = np.array([1.0, 1.0, -1.0])
+    ref = irvine_catenary_inclined_3d(tuple(np.array(A) * flip), tuple(np.array(B) * flip), L0,
+                                      EA, -w_sub)
+    scale = float(np.abs(ref["h"]).max())
+    np.testing.assert_allclose(ds.reaction.sel(node="A").values, -ref["h"] * flip, rtol=0,
+                               atol=1e-9 * scale)
+    np.testing.assert_allclose(ds.reaction.sel(node="B").values, ref["t_B"] * flip, rtol=0,
+                               atol=1e-9 * scale)
+    if ne > 1:
+        s = np.arange(1, ne) * L0 / ne
+        X = ds.position.sel(node=[f"c.{k}" for k in range(1, ne)]).values
+        np.testing.assert_allclose(X, ref["x"](s) * flip, rtol=0, atol=1e-9 * L0)
+
+
 def test_line_crossing_the_surface_converges_to_the_piecewise_catenary():
     """A line from 40 m deep to 10 m above the still water: under water it weighs w - ρ g A,
     above w. The exact static state is the elastic catenary with those two weights, switching
