@@ -21,9 +21,11 @@ from catdae.case.frame import rotate_back, to_gravity_frame
 from catdae.case.sweep import apply_sweep
 from catdae.case.sweep import units as sweep_units
 from catdae.element.elements import NOT_CONVERGED
-from catdae.errors import CaseError, CatdaeError, ConvergenceError, InternalError, OutOfMemory
+from catdae.errors import CatdaeError, ConvergenceError, InternalError, OutOfMemory
 from catdae.model import formfind
 from catdae.model.assembly import Model
+from catdae.model.checks import check_steps
+from catdae.model.fluid import plausibility_note
 from catdae.model.mesh import build_mesh
 from catdae.model.snap import snap_reason
 from catdae.model.span import span_quantities
@@ -158,62 +160,6 @@ def check_case(case: Case):
     return mesh
 
 
-def check_steps(case: Case, mesh) -> None:
-    """What the steps need of the scene, judged before any work (``catdae check`` too).
-
-    A transient step needs inertia at every free node: with no mass there (a massless cable,
-    no point mass) M(q) is singular and the accelerations undefined (they came out NaN).
-    Raises CaseError with the step's field path.
-    """
-    problems = []
-    if case.steps and case.steps[0].sweep is not None and formfind.pending(case):
-        problems.append(("steps[0].sweep", "the first static step finds the cables' lengths "
-                         "(form-finding) and cannot be swept; sweep a later step"))
-    problems += _damper_only_nodes(case, mesh)
-    absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
-              if not x.active}
-    for i, step in enumerate(case.steps):
-        absent = (absent - set(step.add)) | set(step.remove)
-        if step.kind != "transient":
-            continue
-        model = Model(case, mesh, absent, mass_model=step.mass_model, kind=step.kind)
-        massless = model.lumped_mass_diag().reshape(-1, 3)[:, 0] <= 0.0
-        free = ~model.fixed_mask.all(axis=1)
-        names = [mesh.node_names[k] for k in np.flatnonzero(massless & free)]
-        if names:
-            shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5
-                                            else "")
-            problems.append((f"steps[{i}]", f"transient step '{step.name}': free node(s) "
-                             f"{shown} have no mass, so no acceleration is defined: give the "
-                             "cable's material a mass > 0 or put a point mass there"))
-    if problems:
-        raise CaseError(case.path, problems)
-
-
-def _damper_only_nodes(case: Case, mesh) -> list[tuple[str, str]]:
-    """Free nodes that dampers reach but nothing stiff (no cable element, spring or bar):
-    without stiffness they have no static equilibrium (the modal step then failed with "not
-    stable", naming nothing)."""
-    if not case.dampers:
-        return []
-    model = Model(case, mesh, set())
-    cn = model.connectors
-    stiff = np.zeros(mesh.n_nodes, bool)
-    stiff[mesh.conn.ravel()] = True
-    held = np.array([kind != "damper" and k > 0 for kind, k in zip(cn.kinds, cn.stiffness,
-                                                                   strict=True)], bool)
-    stiff[cn.ends[held].ravel()] = True
-    free = ~model.fixed_mask.all(axis=1)
-    out = []
-    for i, d in enumerate(case.dampers):
-        loose = [e for e in d.ends if free[mesh.node_index(e)] and not stiff[mesh.node_index(e)]]
-        out += [(f"dampers[{i}].ends", f"node {e!r} is held by the damper alone (no cable, "
-                 "spring or bar reaches it, and it is not a support): a damper has no "
-                 "stiffness, so the node has no static equilibrium; support it, or join it "
-                 "with a spring or a bar") for e in loose]
-    return out
-
-
 def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, state: _State,
                 progress) -> tuple[xr.Dataset, float | dict]:
     """The step run once per value of its sweep (catdae.case.sweep), each from the same
@@ -310,13 +256,19 @@ def _static_solve(step: Step, model: Model, state: _State):
     (at rest). Returns (solution, the model whose tensions it holds, the seabed summary or
     None)."""
     summary = None
-    if model.case.seabed is not None:  # docs/theory.md §17
-        from catdae.solvers.seabed_static import solve_static_on_seabed
+    try:
+        if model.case.seabed is not None:  # docs/theory.md §17
+            from catdae.solvers.seabed_static import solve_static_on_seabed
 
-        sol, model, summary = solve_static_on_seabed(model, state.X, state.h, t=state.t,
-                                                     load_steps=step.load_steps)
-    else:
-        sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
+            sol, model, summary = solve_static_on_seabed(model, state.X, state.h, t=state.t,
+                                                         load_steps=step.load_steps)
+        else:
+            sol = solve_static(model, state.X, state.h, t=state.t, load_steps=step.load_steps)
+    except ConvergenceError as exc:  # a likely cause in the case, if there is one
+        hint = plausibility_note(model.case, waves=False) if model.fluid is not None else ""
+        if not hint:
+            raise
+        raise ConvergenceError(f"{exc} ({hint})") from exc
     state.X, state.h = sol.X, sol.state.h
     state.V = np.zeros_like(sol.X)
     return sol, model, summary
@@ -351,6 +303,9 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
             f"{100 * np.nanmax(strain[e]):.3g} % (T / EA): far beyond what a cable carries "
             f"(the case check refuses {100 * MAX_STRAIN:g} % in the geometry); check the "
             "loads and their units")
+    fast = plausibility_note(model.case, waves=False) if model.fluid is not None else ""
+    if fast:
+        ds.attrs["note"] = "; ".join(x for x in (ds.attrs.get("note"), fast) if x)
     return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
                                   engineering.rated_strengths(model.case, model.mesh.cable_names))
 

@@ -45,6 +45,9 @@ def found_text(v: Any) -> str:
     if isinstance(v, str):
         return f"the string {shorten(v)}"
     if isinstance(v, list | tuple):
+        if 0 < len(v) <= 6 and all(isinstance(x, int | float) and not isinstance(x, bool)
+                                   and (not isinstance(x, int) or abs(x) < 10**15) for x in v):
+            return f"the array [{', '.join(repr(x) for x in v)}]"  # e.g. [nan, 0.0, 0.0]
         return f"an array of {len(v)} item{'s' if len(v) != 1 else ''}"
     if isinstance(v, Mapping):
         keys = ", ".join(shorten(str(k), 20) for k in list(v)[:5])

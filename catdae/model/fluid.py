@@ -96,6 +96,42 @@ def dispersion(omega: float, g: float, depth: float) -> float:
     return k
 
 
+MICHE = 0.142  # breaking: H / L <= 0.142 tanh(k depth) (Miche 1944; 1/7 in deep water)
+FAST_CURRENT = 10.0  # m/s: no ocean or river current comes near it
+
+
+def plausibility_note(case: Case, waves: bool = True) -> str:
+    """A word where the water is outside what its theory describes ("" when it is not): a
+    regular wave (or a sea's significant height) steeper than the breaking limit, where
+    linear (Airy) kinematics have no meaning, and a current faster than FAST_CURRENT (both
+    are usually a typing slip: H = 60 for 6.0, a current in cm/s). ``waves``: say it of the
+    waves too (transient steps; static and modal steps see still water)."""
+    water = case.water
+    if water is None:
+        return ""
+    notes = []
+    wv = water.waves
+    if waves and wv is not None and case.gravity > 0:
+        h, t, what = ((wv.height, wv.period, "wave height") if wv.kind == "airy"
+                      else (wv.hs, wv.tp, "significant height hs"))
+        k = dispersion(2 * math.pi / t, case.gravity, water.depth)
+        limit = MICHE * 2 * math.pi / k * (1.0 if math.isinf(water.depth)
+                                           else math.tanh(k * water.depth))
+        if h > limit:
+            notes.append(f"the {what} {h:.4g} m at period {t:.4g} s is above the breaking "
+                         f"limit {limit:.4g} m (H/L <= 0.142 tanh(k depth), wavelength "
+                         f"{2 * math.pi / k:.4g} m): linear (Airy) kinematics are far outside "
+                         "their range there")
+    cur = water.current
+    if cur is not None:
+        fast = float(np.linalg.norm(np.asarray(cur.velocity, float).reshape(-1, 3),
+                                    axis=1).max())
+        if fast > FAST_CURRENT:
+            notes.append(f"the current reaches {fast:.4g} m/s, above any ocean or river "
+                         f"current ({FAST_CURRENT:g} m/s): check its units (m/s)")
+    return "; ".join(notes)
+
+
 def wave_components(waves: Waves, g: float, depth: float) -> tuple[np.ndarray, ...]:
     """(amplitude m, ω rad/s, k 1/m, cos heading, sin heading, phase rad) of every component.
 

@@ -441,3 +441,69 @@ def test_drag_through_the_surface_only_takes_energy(mass_model):
         powers.append(-float((out - at_rest) @ V) / max(float(V @ V), 1e-300))
     assert max(powers) <= 0.0
     assert min(powers) < 0.0
+
+
+def _riser(waves: str, current: str = "") -> str:
+    """A taut riser from a 60 m deep floor to 2 m below the surface, 6 elements."""
+    return f"""
+[materials.riser]
+EA = 1.0e10
+mass = 300.0
+diameter = 0.5
+[water]
+density = 1025.0
+depth = 60.0
+{waves}
+{current}
+[nodes]
+bottom = [0.0, 0.0, -60.0]
+top = [0.0, 0.0, -2.0]
+[supports]
+bottom = "pinned"
+top = "pinned"
+[[cables]]
+name = "riser"
+ends = ["bottom", "top"]
+material = "riser"
+length = 57.99
+elements = 6
+[[steps]]
+kind = "static"
+name = "still"
+[[steps]]
+kind = "transient"
+name = "waves"
+duration = 0.05
+output_interval = 0.05
+"""
+
+
+@pytest.mark.parametrize("height, breaking", [(30.0, False), (40.0, True)])
+def test_a_wave_beyond_breaking_is_noted(height, breaking):
+    """A tester's H = 50 m, T = 14 s wave in 60 m of water ran silently on Airy kinematics. The
+    breaking limit H = 0.142 L tanh(k d) (Miche), with L from ω² = g k tanh(k d) solved here on
+    its own, is 33.6 m for T = 14 s in 60 m: 40 m is noted in the transient, 30 m is not."""
+    from scipy.optimize import brentq
+
+    w = 2 * math.pi / 14.0
+    k = brentq(lambda k: G * k * math.tanh(k * 60.0) - w * w, 1e-6, 1.0)
+    limit = 0.142 * 2 * math.pi / k * math.tanh(k * 60.0)
+    assert 30.0 < limit < 40.0
+    text = _riser(f'waves = {{ kind = "airy", height = {height}, period = 14.0 }}')
+    tree = catdae.run(load_case(text))
+    note = tree["waves"].ds.attrs.get("note", "")
+    assert ("above the breaking limit" in note) == breaking
+    if breaking:
+        assert f"breaking limit {limit:.4g} m" in note
+    assert "breaking" not in tree["still"].ds.attrs.get("note", "")  # still water there
+
+
+def test_a_current_faster_than_any_sea_is_noted_and_a_nan_one_shown():
+    """A current of 12 m/s (a slip of units) is named in the static note; a NaN component is
+    shown in the message as it was given (it said only "an array of 3 items")."""
+    tree = catdae.run(load_case(_riser("", "current = [12.0, 0.0, 0.0]")))
+    assert "the current reaches 12 m/s" in tree["still"].ds.attrs["note"]
+    calm = catdae.run(load_case(_riser("", "current = [1.5, 0.0, 0.0]")))
+    assert "note" not in calm["still"].ds.attrs
+    with pytest.raises(catdae.CaseError, match=r"found the array \[nan, 0\.0, 0\.0\]"):
+        load_case(_riser("", "current = [nan, 0.0, 0.0]"))
