@@ -42,6 +42,8 @@ def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarra
     |uᵀ φ|² / (|u|² |φ|²); 0 beyond the k found. Damped modes are sorted by |s| and the
     overdamped ones dropped, so the k-th damped mode need not be the k-th undamped one."""
     out = np.zeros(n, dtype=np.int32)
+    if damped.shape[0] == 0 or undamped.shape[0] == 0:  # none found underdamped
+        return out
     u = np.nan_to_num(undamped.reshape(undamped.shape[0], -1))
     d = np.nan_to_num(damped.reshape(damped.shape[0], -1))[:n]
     if d.size and u.size:
