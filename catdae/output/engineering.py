@@ -13,6 +13,8 @@ motion does in one output interval.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from catdae._xr import xr
@@ -67,6 +69,39 @@ def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
         data["clearance"] = _cable_var(quantities["clearance"], "m", _CLEARANCE)
         data["clearance_s"] = _cable_var(quantities["clearance_s"], "m",
                                          "unstrained arc length where the clearance is least")
+    return ds.assign(data)
+
+
+def cable_temperature_changes(names: list[str], change) -> np.ndarray:
+    """Each cable's temperature change from the reference temperature, K, in ``names`` order:
+    (n_cables,) for a step's change (one number, or per cable: a cable the table does not
+    name is at the reference temperature, 0), (n_values, n_cables) for an array over the values
+    of a temperature sweep."""
+    if isinstance(change, Mapping):
+        return np.array([float(change.get(n, 0.0)) for n in names])
+    c = np.asarray(change, float)
+    return np.repeat(c[..., None], len(names), axis=-1)
+
+
+def add_temperatures(ds: xr.Dataset, names: list[str], change,
+                     reference: float | None) -> xr.Dataset:
+    """``temperature_change``(cable) K, and with the case's ``reference`` temperature
+    ``temperature``(cable) (its units: °C or K), of each cable in the step (``change`` as
+    :func:`cable_temperature_changes` takes it; (sweep, cable) over a temperature sweep)."""
+    per = cable_temperature_changes(names, change)
+    dims = ("sweep", "cable") if per.ndim == 2 else ("cable",)
+    if "cable" in ds.coords:  # the group's own order of the cables
+        per = per[..., [names.index(str(c)) for c in ds.cable.values]]
+    else:
+        ds = ds.assign_coords(cable=xr.Variable("cable", np.array(names, dtype=object),
+                                                {"long_name": "cable name"}))
+    data = {"temperature_change": xr.Variable(dims, per, {
+        "units": "K", "long_name": "temperature change of the cable in this step from the "
+        "case's reference temperature (0: at the reference temperature)"})}
+    if reference is not None:
+        data["temperature"] = xr.Variable(dims, reference + per, {
+            "long_name": "temperature of the cable in this step, in the units of the case's "
+            "reference_temperature (degrees Celsius or kelvins)"})
     return ds.assign(data)
 
 

@@ -28,9 +28,7 @@ def _step_lines(name: str, ds) -> list[str]:
     lines = []
     kind = ds.attrs.get("kind", "")
     if kind == "static":
-        hot = (f" at {ds.attrs['temperature']:.6g} deg" if "temperature" in ds.attrs
-               else "")
-        lines.append(f"[{name}] static{hot}: {ds.attrs.get('iterations')} Newton "
+        lines.append(f"[{name}] static{_temperatures(ds)}: {ds.attrs.get('iterations')} Newton "
                      f"iterations, residual {ds.attrs.get('residual_norm', 0):.2e} N")
         lines.extend(_cable_lines(ds))
         if ds.attrs.get("note"):
@@ -61,6 +59,22 @@ def _step_lines(name: str, ds) -> list[str]:
         if a.get("note"):
             lines.append(f"    note: {a['note']}")
     return lines
+
+
+def _temperatures(ds) -> str:
+    """The step's temperature: uniform over the cables (the attr), or each cable's when they
+    differ (its temperature, or without a reference temperature its temperature change)."""
+    if "temperature" in ds.attrs:
+        return f" at {float(ds.attrs['temperature']):.6g} deg"
+    if "temperature_change" in ds.attrs:  # uniform, without a reference temperature
+        return ""
+    for var, unit, fmt in (("temperature", "deg", ".6g"), ("temperature_change", "K", "+.6g")):
+        if var in ds and ds[var].ndim == 1:
+            each = ", ".join(f"{c} {float(t):{fmt}}" for c, t in zip(
+                ds.cable.values, ds[var].values, strict=True))
+            return (f" at {each} {unit}" if var == "temperature"
+                    else f" with temperature changes {each} {unit}")
+    return ""
 
 
 def _mode_lines(name: str, ds) -> list[str]:
