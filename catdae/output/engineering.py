@@ -131,7 +131,8 @@ def _extreme(var: xr.DataArray, how: str, what: str) -> dict[str, xr.Variable]:
 def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
                   up: np.ndarray | None = None) -> xr.Dataset:
     """The transient group with its envelopes over the output times: ``reaction_max``,
-    ``reaction_min`` (node, axis) and their ``_time``, the same for ``displacement``; per
+    ``reaction_min`` (node, axis) and their ``_time``, the same for ``displacement`` and
+    ``connector_swing_angle`` (connector); per
     cable ``tension_percent_rated`` (of ``tension_max``) when a material has a rated strength;
     and with ``reference`` (the named static step's group) ``jump_height``, ``jump_time`` and
     ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z)."""
@@ -141,6 +142,9 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
     for how in ("max", "min"):
         data.update(_extreme(ds.reaction, how, "force the support exerts on the cable"))
         data.update(_extreme(ds.displacement, how, "displacement"))
+        if "connector_swing_angle" in ds:
+            data.update(_extreme(ds.connector_swing_angle, how,
+                                 "angle of the connector's axis from the vertical"))
     cables = list(dict.fromkeys(str(c) for c in ds.element_cable.values))
     rated = rated_strengths(case, cables)
     if np.isfinite(rated).any():
