@@ -19,6 +19,7 @@ import numpy as np
 
 from catdae._xr import xr
 from catdae.case.frame import gravity_rotation
+from catdae.output.end_peaks import with_end_note
 
 _SPAN = {  # name: (units, long_name)
     "horizontal_tension_along_chord": (
@@ -135,7 +136,9 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
     ``connector_swing_angle`` (connector); per
     cable ``tension_percent_rated`` (of ``tension_max``) when a material has a rated strength;
     and with ``reference`` (the named static step's group) ``jump_height``, ``jump_time`` and
-    ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z)."""
+    ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z). Its
+    ``note`` says which peaks are at the step's last output time
+    (catdae.output.end_peaks)."""
     if ds.sizes.get("time", 0) == 0:
         return ds
     data = {}
@@ -161,7 +164,7 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
         out = out.assign(jump(ds, reference, cables, up))
     if getattr(case, "ground", None) is not None:
         out = out.assign(clearance_over_time(ds, case.ground, cables, up))
-    return out
+    return with_end_note(out)
 
 
 def clearance_over_time(ds: xr.Dataset, ground, cables: list[str],

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from catdae.output.end_peaks import at_end
 from catdae.output.reading import step_values
 
 
@@ -131,10 +132,11 @@ def _jump_lines(ds) -> list[str]:
     for k, cab in enumerate(ds.cable.values if "cable" in ds.coords else ()):
         parts = []
         if "jump_height" in ds:
+            when = float(ds.jump_time.values[k])
             parts.append(f"jump {float(ds.jump_height.values[k]):.6g} m above step "
-                         f"'{ds.attrs.get('jump_reference', '')}' at t = "
-                         f"{float(ds.jump_time.values[k]):.6g} s, s = "
-                         f"{float(ds.jump_s.values[k]):.6g} m")
+                         f"'{ds.attrs.get('jump_reference', '')}' at t = {when:.6g} s"
+                         + (" (at the step's end: may still be rising)" if at_end(when, ds)
+                            else "") + f", s = {float(ds.jump_s.values[k]):.6g} m")
         if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
             parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % "
                          "of rated strength")

@@ -132,6 +132,36 @@ def test_ice_shedding_jump(tmp_path):
                - tree["bare"].ds.displacement.sel(node="wire.12", axis="z"))
     assert dz == pytest.approx(float(jump.jump_height), rel=1e-12)
     assert float(ds.displacement_max_time.sel(node="wire.12", axis="z")) == float(jump.jump_time)
+    assert "may still be growing" not in ds.attrs["note"]  # the peaks are inside the step
+
+
+def test_a_jump_still_rising_at_the_step_end_is_flagged(tmp_path, capsys):
+    """The taut wire of ice_shedding.toml rises until half a period 1/(2 f1) = 0.134 s after
+    the ice drops (the string's closed form, above): cut at 0.1 s, its largest rise is at the
+    step's last output, and the step's note and the printed jump say it may still be rising.
+    The midspan's upward displacement peaks there too (its headline, named in the note)."""
+    text = (CASES / "ice_shedding.toml").read_text()
+    assert "duration = 0.6\n" in text
+    case = tmp_path / "short.toml"
+    case.write_text(text.replace("duration = 0.6\n", "duration = 0.1\n"))
+    out = tmp_path / "short.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    c = catdae.load_case(case)
+    L0 = float(catdae.read_results(out)["bare"].ds.unstrained_length.sel(cable="wire"))
+    H = level_span(L0, c.materials["steel"].EA, c.materials["steel"].mass * G, 0.0, 60.0)[1]
+    f1 = math.sqrt(H / c.materials["steel"].mass) / (2 * 60.0)
+    ds = catdae.read_results(out)["shedding"].ds
+    end = float(ds.time[-1])
+    assert end == pytest.approx(0.1) and end < 0.5 / f1
+    assert float(ds.jump_time.sel(cable="wire")) == end
+    note = ds.attrs["note"]
+    assert "t = 0.1 s" in note and "may still be growing" in note, note
+    assert "jump_height of cable wire" in note, note
+    assert "displacement_max at wire." in note, note
+    line = next(s for s in printed.splitlines() if "cable wire: jump " in s)
+    assert f"at t = {end:.6g} s (at the step's end: may still be rising)" in line, line
+    assert f"note: {note}" in printed
 
 
 def test_per_cable_temperatures(tmp_path, capsys):
