@@ -10,7 +10,7 @@ from __future__ import annotations
 import copy
 import os
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
@@ -312,24 +312,40 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
 
 def engineering_results(step: Step, ds: xr.Dataset, case: Case,
                         groups: dict[str, xr.Dataset], temperature) -> xr.Dataset:
-    """A step's group (in the case's axes) with, for a uniform temperature change, the attrs
-    ``temperature_change`` (K) and, with the case's ``reference_temperature``, ``temperature``;
-    a transient group also with its envelopes and, after a ``jump_reference`` static step,
-    the jump of each cable (catdae.output.engineering)."""
+    """A step's group (in the case's axes) with, for a temperature change uniform over the
+    cables, the attrs ``temperature_change`` (K) and, with the case's
+    ``reference_temperature``, ``temperature``; in a case with a thermal field, a static or
+    transient group also has them per cable; a transient group also with its envelopes and,
+    after a ``jump_reference`` static step, the jump of each cable
+    (catdae.output.engineering)."""
     if step.sweep is not None and step.sweep.field == "temperature_change":
         temperature = np.array(step.sweep.values)  # one per value (the sweep's attributes)
         ds.attrs["sweep_attributes"] = " ".join(sorted(
             {*ds.attrs["sweep_attributes"].split(), "temperature_change", "temperature"}))
-    if not isinstance(temperature, dict) and not hasattr(temperature, "items"):
+    names = [c.name for c in case.cables]
+    per = engineering.cable_temperature_changes(names, temperature)
+    if isinstance(temperature, Mapping) and names and np.all(per == per[0]):
+        temperature = float(per[0])  # a table that gives every cable the same change
+    if not isinstance(temperature, Mapping):
         ds = ds.assign_attrs(temperature_change=_number(temperature))
         if case.reference_temperature is not None:
             ds = ds.assign_attrs(temperature=_number(case.reference_temperature + temperature))
-    if step.kind != "transient":
-        return ds
-    ref = groups.get(step.jump_reference) if step.jump_reference else None
-    if ref is not None:
-        ds = ds.assign_attrs(jump_reference=step.jump_reference)
-    return engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
+    if step.kind == "transient":
+        ref = groups.get(step.jump_reference) if step.jump_reference else None
+        if ref is not None:
+            ds = ds.assign_attrs(jump_reference=step.jump_reference)
+        ds = engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
+    if step.kind != "modal" and names and _thermal(case):
+        ds = engineering.add_temperatures(ds, names, temperature, case.reference_temperature)
+    return ds
+
+
+def _thermal(case: Case) -> bool:
+    """Whether a case has a thermal field: a reference temperature, a step's temperature (or
+    change), a temperature sweep."""
+    return case.reference_temperature is not None or any(
+        s.temperature_change is not None
+        or (s.sweep is not None and s.sweep.field == "temperature_change") for s in case.steps)
 
 
 def _number(x):

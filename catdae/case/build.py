@@ -147,6 +147,9 @@ class Builder(CablesPass, ConnectorsPass, StepsPass, SweepPass, TimePass, FluidP
         self.unique_names(top)
         motions = self.support_motions(top.support_motions, nodes, supports)
         self.reference_temperature = top.reference_temperature
+        if top.reference_temperature is not None:
+            self.below_absolute_zero(top.reference_temperature, ("reference_temperature",),
+                                     "reference_temperature")
         ground = self.ground(top.ground)
         steps = self.steps(top.steps)
         water, air = self.water(top.water), self.air(top.air)

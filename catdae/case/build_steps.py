@@ -28,6 +28,8 @@ from catdae.case.schema import (
 )
 from catdae.case.timefunc_compose import Scaled
 
+ABSOLUTE_ZERO = -273.15  # °C: no temperature is below it, in °C or in K (docs/case-format.md)
+
 
 class StepsPass:
     """Support motions and steps (methods of ``_Builder``)."""
@@ -182,7 +184,8 @@ class StepsPass:
                          "mass_model": v.mass_model, "inertia": v.inertia,
                          "axial_damping": self.axial_damping(v.axial_damping, where),
                          "resolve": v.resolve,
-                         "jump_reference": self.jump_reference(v, where, out)}
+                         "jump_reference": self.jump_reference(v, where, out, nm,
+                                                               raw[i + 1:])}
             temperature = self.step_temperature(v, where)
             sweep = self.sweep(v.sweep, where, self.connector_items)
             if complete and temperature is not False and sweep is not False:
@@ -214,15 +217,41 @@ class StepsPass:
             return FrozenMap({k: t - ref for k, t in change.items()})
         return change - ref
 
-    def jump_reference(self, v: Any, where: tuple, earlier: list[Step]) -> str | None:
-        """A transient step's ``jump_reference``: the name of an earlier static step."""
+    def below_absolute_zero(self, value: float, where: tuple, what: str) -> bool:
+        """A temperature below absolute zero (-273.15 °C; 0 K is above it) is refused; True
+        when it was."""
+        if value >= ABSOLUTE_ZERO:
+            return False
+        self.problem(where, f"{what} {value:g} is below absolute zero (-273.15 °C, 0 K) in "
+                     "either unit reference_temperature may have (°C or K)")
+        return True
+
+    def jump_reference(self, v: Any, where: tuple, earlier: list[Step], own: str,
+                       later: list) -> str | None:
+        """A transient step's ``jump_reference``: the name of an earlier static step (``own``:
+        the step's name, ``later``: the raw steps after it, for a message that says what a
+        wrong name names)."""
         name = v.jump_reference
         if name is None:
             return None
         static = [s.name for s in earlier if s.kind == "static"]
-        if name not in static:
-            self.problem(where + ("jump_reference",), unknown_word(name, "static step before this "
-                                                               "one", static))
+        if name in static:
+            return name
+        kinds = {s.name: s.kind for s in earlier}
+        after = {r.get("name") for r in later if isinstance(r, dict)}
+        expected = (f"; expected a static step before this one: "
+                    f"{', '.join(repr(s) for s in static)}" if static
+                    else "; there is no static step before this one")
+        if name == own:
+            said = f"{name!r} is the step itself, not a static step before it{expected}"
+        elif name in kinds:
+            said = f"{name!r} is a {kinds[name]} step, not a static step{expected}"
+        elif name in after:
+            said = (f"{name!r} comes after this step; jump_reference names a static step "
+                    f"before it{expected}")
+        else:
+            said = unknown_word(name, "static step before this one", static)
+        self.problem(where + ("jump_reference",), said)
         return name
 
     def temperature(self, raw: Any, where: tuple,
@@ -236,7 +265,7 @@ class StepsPass:
         if raw is None:
             return None
         if is_number(raw):
-            return float(raw)
+            return False if self.too_cold(float(raw), where, change) else float(raw)
         if not isinstance(raw, dict):
             self.problem(where, f"expected {what} (a number, for every cable) or a table "
                          f"cable name -> {'K' if change else 'temperature'}, "
@@ -251,7 +280,20 @@ class StepsPass:
                 self.problem(where + (key,), f"expected {what} (a finite number), found "
                              f"{found_text(value)}")
                 ok = False
+            elif self.too_cold(float(value), where + (key,), change):
+                ok = False
         return FrozenMap({k: float(v) for k, v in raw.items()}) if ok else False
+
+    def too_cold(self, value: float, where: tuple, change: bool) -> bool:
+        """A ``temperature`` (or with ``reference_temperature`` a ``temperature_change``) that
+        puts a cable below absolute zero; True when it was refused."""
+        ref = self.reference_temperature
+        if not change:
+            return self.below_absolute_zero(value, where, "a temperature of")
+        if ref is None or not np.isfinite(ref):
+            return False
+        return self.below_absolute_zero(ref + value, where, f"reference_temperature {ref:g} "
+                                        f"plus a temperature_change of {value:g} is")
 
     def form_first_step(self, cables: dict, steps: list[Step], raw_steps: list) -> None:
         """Form-finding holds in the first static step, which must then come first."""

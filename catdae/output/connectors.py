@@ -14,7 +14,8 @@ from catdae.output.results import label, var
 
 def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
                           V: np.ndarray | None = None) -> xr.Dataset:
-    """``connector_force`` (N, tension positive) from positions X (..., n_nodes, 3) and
+    """``connector_force`` (N, tension positive) and ``connector_swing_angle`` (degrees,
+    :func:`swing_angles`) from positions X (..., n_nodes, 3) in the gravity frame and
     velocities V (same shape, or None: at rest); a leading ``time`` axis when X has one."""
     if connectors is None:
         return ds
@@ -28,6 +29,10 @@ def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
     return ds.assign(
         connector_force=var(dims, N, "N", "axial force of the connector (tension positive): "
                              "k (d - L) + c dd/dt"),
+        connector_swing_angle=var(dims, swing_angles(connectors, X), "degree",
+                                   "angle of the connector's axis (end a to end b) from the "
+                                   "vertical line (0: hanging or standing straight; NaN for a "
+                                   "damper)"),
     ).assign_coords(
         connector=label("connector", connectors.names, "connector name"),
         connector_kind=label("connector", connectors.kinds, "spring, damper or bar"),
@@ -52,6 +57,17 @@ def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarra
         mac = num / np.where(den > 0, den, 1.0)
         out[:d.shape[0]] = np.argmax(mac, axis=1) + 1
     return out
+
+
+def swing_angles(connectors, X: np.ndarray) -> np.ndarray:
+    """The angle of each spring's and bar's axis from the vertical line, degrees in [0, 90]
+    (atan of its horizontal length over its vertical one; an insulator string's swing: under a
+    lateral load P and a vertical load W at its lower end, tan θ = P / W), (..., n); NaN for
+    dampers. X (..., n_nodes, 3) in the gravity frame (z up, catdae.case.frame)."""
+    X = np.asarray(X)
+    d = X[..., connectors.ends[:, 1], :] - X[..., connectors.ends[:, 0], :]  # (..., n, 3) m
+    angle = np.degrees(np.arctan2(np.hypot(d[..., 0], d[..., 1]), np.abs(d[..., 2])))
+    return np.where(np.array(connectors.kinds) == "damper", np.nan, angle)
 
 
 def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry

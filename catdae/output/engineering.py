@@ -13,10 +13,13 @@ motion does in one output interval.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from catdae._xr import xr
 from catdae.case.frame import gravity_rotation
+from catdae.output.end_peaks import with_end_note
 
 _SPAN = {  # name: (units, long_name)
     "horizontal_tension_along_chord": (
@@ -70,6 +73,39 @@ def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
     return ds.assign(data)
 
 
+def cable_temperature_changes(names: list[str], change) -> np.ndarray:
+    """Each cable's temperature change from the reference temperature, K, in ``names`` order:
+    (n_cables,) for a step's change (one number, or per cable: a cable the table does not
+    name is at the reference temperature, 0), (n_values, n_cables) for an array over the values
+    of a temperature sweep."""
+    if isinstance(change, Mapping):
+        return np.array([float(change.get(n, 0.0)) for n in names])
+    c = np.asarray(change, float)
+    return np.repeat(c[..., None], len(names), axis=-1)
+
+
+def add_temperatures(ds: xr.Dataset, names: list[str], change,
+                     reference: float | None) -> xr.Dataset:
+    """``temperature_change``(cable) K, and with the case's ``reference`` temperature
+    ``temperature``(cable) (its units: °C or K), of each cable in the step (``change`` as
+    :func:`cable_temperature_changes` takes it; (sweep, cable) over a temperature sweep)."""
+    per = cable_temperature_changes(names, change)
+    dims = ("sweep", "cable") if per.ndim == 2 else ("cable",)
+    if "cable" in ds.coords:  # the group's own order of the cables
+        per = per[..., [names.index(str(c)) for c in ds.cable.values]]
+    else:
+        ds = ds.assign_coords(cable=xr.Variable("cable", np.array(names, dtype=object),
+                                                {"long_name": "cable name"}))
+    data = {"temperature_change": xr.Variable(dims, per, {
+        "units": "K", "long_name": "temperature change of the cable in this step from the "
+        "case's reference temperature (0: at the reference temperature)"})}
+    if reference is not None:
+        data["temperature"] = xr.Variable(dims, reference + per, {
+            "long_name": "temperature of the cable in this step, in the units of the case's "
+            "reference_temperature (degrees Celsius or kelvins)"})
+    return ds.assign(data)
+
+
 def _extreme(var: xr.DataArray, how: str, what: str) -> dict[str, xr.Variable]:
     """``<name>_<how>`` and ``<name>_<how>_time`` over time (NaN where the variable is NaN
     throughout, e.g. reactions at free nodes)."""
@@ -96,16 +132,22 @@ def _extreme(var: xr.DataArray, how: str, what: str) -> dict[str, xr.Variable]:
 def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
                   up: np.ndarray | None = None) -> xr.Dataset:
     """The transient group with its envelopes over the output times: ``reaction_max``,
-    ``reaction_min`` (node, axis) and their ``_time``, the same for ``displacement``; per
+    ``reaction_min`` (node, axis) and their ``_time``, the same for ``displacement`` and
+    ``connector_swing_angle`` (connector); per
     cable ``tension_percent_rated`` (of ``tension_max``) when a material has a rated strength;
     and with ``reference`` (the named static step's group) ``jump_height``, ``jump_time`` and
-    ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z)."""
+    ``jump_s`` per cable, the rise measured along ``up`` (a unit vector, default +z). Its
+    ``note`` says which peaks are at the step's last output time
+    (catdae.output.end_peaks)."""
     if ds.sizes.get("time", 0) == 0:
         return ds
     data = {}
     for how in ("max", "min"):
         data.update(_extreme(ds.reaction, how, "force the support exerts on the cable"))
         data.update(_extreme(ds.displacement, how, "displacement"))
+        if "connector_swing_angle" in ds:
+            data.update(_extreme(ds.connector_swing_angle, how,
+                                 "angle of the connector's axis from the vertical"))
     cables = list(dict.fromkeys(str(c) for c in ds.element_cable.values))
     rated = rated_strengths(case, cables)
     if np.isfinite(rated).any():
@@ -122,7 +164,7 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
         out = out.assign(jump(ds, reference, cables, up))
     if getattr(case, "ground", None) is not None:
         out = out.assign(clearance_over_time(ds, case.ground, cables, up))
-    return out
+    return with_end_note(out)
 
 
 def clearance_over_time(ds: xr.Dataset, ground, cables: list[str],

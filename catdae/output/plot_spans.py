@@ -28,12 +28,24 @@ def static_groups(tree: xr.DataTree, steps=None) -> list[tuple[str, xr.Dataset]]
     return out
 
 
+def uniform_temperature(ds: xr.Dataset) -> float | None:
+    """The step's temperature when it is the same for every cable (the attr, or the per-cable
+    ``temperature`` when its values agree), else None."""
+    if "temperature" in ds.attrs:
+        return float(ds.attrs["temperature"])
+    t = ds.get("temperature")
+    if t is None or t.ndim != 1 or not t.size or not np.all(t.values == t.values[0]):
+        return None
+    return float(t.values[0])
+
+
 def spans(tree: xr.DataTree, steps=None) -> Figure:
     """Sag at midspan and at the lowest point (above), the largest tension as a percentage of
     the rated strength, or else the horizontal tension along the chord (below), per cable,
-    against the steps' ``temperature`` when every step has one, else against the steps."""
+    against the steps' ``temperature`` when every step has one the same for every cable, else
+    against the steps."""
     groups = static_groups(tree, steps)
-    temps = [ds.attrs.get("temperature") for _, ds in groups]
+    temps = [uniform_temperature(ds) for _, ds in groups]
     by_temperature = all(t is not None for t in temps)
     x = np.array(temps, float) if by_temperature else np.arange(len(groups), dtype=float)
     order = np.argsort(x, kind="stable")

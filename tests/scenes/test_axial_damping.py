@@ -296,6 +296,9 @@ def test_note_on_a_load_removed_from_a_slack_cable():
     ds = catdae.run(case(15.0, "blended"))["let go"].to_dataset()
     assert ds.attrs["mass_model"] == "blended"
     assert "'lift' added or removed" in ds.attrs["note"] and "lumped" in ds.attrs["note"]
-    assert catdae.run(case(15.0, "lumped"))["let go"].to_dataset().attrs["note"] == ""
+    # nothing to say about the mass (the note of this 0.01 s step only says that its peaks
+    # are at its end: catdae.output.end_peaks)
+    assert "mass_model" not in catdae.run(case(15.0, "lumped"))["let go"].to_dataset().attrs[
+        "note"]
     taut = catdae.run(case(9.99, None))["let go"].to_dataset()
-    assert taut.attrs["note"] == "" and taut.attrs["mass_model"] == "blended"
+    assert "mass_model" not in taut.attrs["note"] and taut.attrs["mass_model"] == "blended"

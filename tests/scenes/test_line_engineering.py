@@ -26,6 +26,8 @@ from catdae.output import plot_spans
 
 from reference import irvine_catenary
 from repo_paths import CASES
+from scene_toml import cable, scene
+from scene_toml import step as step_block
 
 G = 9.81
 
@@ -130,3 +132,88 @@ def test_ice_shedding_jump(tmp_path):
                - tree["bare"].ds.displacement.sel(node="wire.12", axis="z"))
     assert dz == pytest.approx(float(jump.jump_height), rel=1e-12)
     assert float(ds.displacement_max_time.sel(node="wire.12", axis="z")) == float(jump.jump_time)
+    assert "may still be growing" not in ds.attrs["note"]  # the peaks are inside the step
+
+
+def test_a_jump_still_rising_at_the_step_end_is_flagged(tmp_path, capsys):
+    """The taut wire of ice_shedding.toml rises until half a period 1/(2 f1) = 0.134 s after
+    the ice drops (the string's closed form, above): cut at 0.1 s, its largest rise is at the
+    step's last output, and the step's note and the printed jump say it may still be rising.
+    The midspan's upward displacement peaks there too (its headline, named in the note)."""
+    text = (CASES / "ice_shedding.toml").read_text()
+    assert "duration = 0.6\n" in text
+    case = tmp_path / "short.toml"
+    case.write_text(text.replace("duration = 0.6\n", "duration = 0.1\n"))
+    out = tmp_path / "short.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    c = catdae.load_case(case)
+    L0 = float(catdae.read_results(out)["bare"].ds.unstrained_length.sel(cable="wire"))
+    H = level_span(L0, c.materials["steel"].EA, c.materials["steel"].mass * G, 0.0, 60.0)[1]
+    f1 = math.sqrt(H / c.materials["steel"].mass) / (2 * 60.0)
+    ds = catdae.read_results(out)["shedding"].ds
+    end = float(ds.time[-1])
+    assert end == pytest.approx(0.1) and end < 0.5 / f1
+    assert float(ds.jump_time.sel(cable="wire")) == end
+    note = ds.attrs["note"]
+    assert "t = 0.1 s" in note and "may still be growing" in note, note
+    assert "jump_height of cable wire" in note, note
+    assert "displacement_max at wire." in note, note
+    line = next(s for s in printed.splitlines() if "cable wire: jump " in s)
+    assert f"at t = {end:.6g} s (at the step's end: may still be rising)" in line, line
+    assert f"note: {note}" in printed
+
+
+def test_per_cable_temperatures(tmp_path, capsys):
+    """Two independent level Drake spans (300 m, L0 300.108303 m, at 15 °C). After both are at
+    50 °C, ``temperature = { c1 = 75.0 }`` heats c1 to 75 °C and puts c2, which it does not
+    name, back at the reference temperature: each sag is the closed form's at its own
+    temperature; the group records each cable's temperature and change, the printed step line
+    lists them, and the next step (no temperature) keeps them. A table that gives the one
+    cable of a scene a temperature is uniform: the group has the attrs as for a number."""
+    EA, mass, alpha, L0 = 3.28e7, 1.628, 18.9e-6, 300.108303
+    text = scene(
+        head={"reference_temperature": 15.0},
+        materials={"drake": {"EA": EA, "mass": mass, "thermal_expansion": alpha}},
+        nodes={"A": (0.0, 0.0, 30.0), "B": (300.0, 0.0, 30.0), "C": (0.0, 50.0, 30.0),
+               "D": (300.0, 50.0, 30.0)},
+        supports=("A", "B", "C", "D"),
+        cables=[cable("c1", ("A", "B"), "drake", L0, 10),
+                cable("c2", ("C", "D"), "drake", L0, 10)],
+        steps=step_block("static", "all50", temperature=50.0)
+        + step_block("static", "c1hot", temperature={"c1": 75.0}) + step_block("static", "next")
+        + step_block("transient", "moving", duration=0.02, output_interval=0.01))
+    case = tmp_path / "two.toml"
+    case.write_text(text)
+    out = tmp_path / "two.nc"
+    assert main(["run", str(case), "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    tree = catdae.read_results(out)
+    w = mass * G
+    for name in ("c1hot", "next"):
+        ds = tree[name].ds
+        assert "temperature" not in ds.attrs and "temperature_change" not in ds.attrs
+        assert ds.temperature.sel(cable="c1") == 75.0 and ds.temperature.sel(cable="c2") == 15.0
+        assert ds.temperature_change.values.tolist() == [60.0, 0.0]
+        assert ds.temperature_change.attrs["units"] == "K"
+        assert "temperature of the cable" in ds.temperature.attrs["long_name"]
+        for cab, T in (("c1", 75.0), ("c2", 15.0)):
+            sag = level_span(L0, EA, w, alpha * (T - 15.0), 300.0)[0]
+            assert float(ds.sag_midspan.sel(cable=cab)) == pytest.approx(sag, rel=1e-9), cab
+        assert f"[{name}] static at c1 75, c2 15 deg:" in printed, printed
+    both = tree["all50"].ds
+    assert both.attrs["temperature"] == 50.0 and both.temperature.values.tolist() == [50.0] * 2
+    assert "[all50] static at 50 deg:" in printed
+    moving = tree["moving"].ds  # a transient group too
+    assert moving.temperature.values.tolist() == [75.0, 15.0]
+    # one cable named by a table: uniform, so the attrs (and the sag-temperature figure)
+    one = catdae.run(catdae.load_case(scene(
+        head={"reference_temperature": 15.0},
+        materials={"drake": {"EA": EA, "mass": mass, "thermal_expansion": alpha}},
+        nodes={"A": (0.0, 0.0, 30.0), "B": (300.0, 0.0, 30.0)},
+        cables=cable("c1", ("A", "B"), "drake", L0, 10),
+        steps=step_block("static", "ref") + step_block("static", "hot", temperature={"c1": 75.0}))))
+    assert one["hot"].ds.attrs["temperature"] == 75.0
+    assert one["hot"].ds.attrs["temperature_change"] == 60.0
+    drawn = {ln.get_gid(): ln for ax in plot_spans.spans(one).axes for ln in ax.get_lines()}
+    assert drawn["c1|sag_midspan"].get_xdata().tolist() == [15.0, 75.0]

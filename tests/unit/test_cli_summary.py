@@ -18,7 +18,7 @@ import catdae
 from catdae.cli import main
 
 from reference import irvine_catenary
-from scene_toml import cable_scene, distributed_load, modal_step, static_step
+from scene_toml import cable_scene, distributed_load, modal_step, static_step, step
 
 EA, MASS, G, WIND, L0 = 2.0e7, 1.6, 9.81, 9.0, 101.0
 
@@ -65,3 +65,33 @@ def test_the_horizontal_tension_says_what_it_includes(printed):
     line = next(s for s in text.splitlines() if s.strip().startswith("cable span"))
     assert f"horizontal tension {whole:.6g} N at A (includes the part across the chord)" in line
     assert f"along the chord {along:.6g} N" in line
+
+
+def test_still_air_reads_plainly(tmp_path, capsys):
+    """An inclined span in still air, after a wind has come and gone: it hangs in the vertical
+    plane through its chord again, so its horizontal tension is all along the chord (no part
+    across it to mention) and its swing angle is 0 (the stored one is a rounding residue of
+    the wind's state, about 1e-15 deg, printed as 0); under the wind the line says that the
+    horizontal tension includes the part across the chord."""
+    case = tmp_path / "gone.toml"
+    case.write_text(cable_scene(
+        B=(100.0, 0.0, 10.0), L0=101.5, EA=EA, mass=MASS, elements=12, cable="span",
+        extra=distributed_load("span", [0.0, WIND, 0.0], name="wind", active=False),
+        steps=static_step("still") + step("static", "windy", add=["wind"])
+        + step("static", "calm", remove=["wind"])))
+    assert main(["run", str(case), "-o", str(tmp_path / "gone.nc"), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    tree = catdae.read_results(tmp_path / "gone.nc")
+    lines = dict(re.findall(r"^\[(\w+)\] static.*\n +(cable span: .*)\n +(?:.*)$", text, re.M))
+    spans = dict(re.findall(r"^\[(\w+)\] static.*\n +cable span: .*\n +(.*)$", text, re.M))
+    assert set(lines) == {"still", "windy", "calm"}, text
+    for name in ("still", "calm"):
+        ds = tree[name].to_dataset()
+        assert float(ds.horizontal_tension_along_chord.sel(cable="span")) == pytest.approx(
+            float(ds.horizontal_tension.sel(cable="span")), rel=1e-12)
+        assert abs(float(ds.swing_angle.sel(cable="span"))) < 1e-9
+        assert "across the chord" not in lines[name], lines[name]
+        assert "swing angle 0 deg" in spans[name], spans[name]
+    assert "(includes the part across the chord)" in lines["windy"]
+    windy = tree["windy"].to_dataset()
+    assert f"swing angle {float(windy.swing_angle.sel(cable='span')):.6g} deg" in spans["windy"]

@@ -94,7 +94,20 @@ def test_temperature_is_measured_from_the_reference_temperature():
      "steps[0].temperature", "expected a temperature (the units"),
     (None, transient(jump_reference="rst"), "steps[1].jump_reference", "did you mean 'rest'"),
     (None, step("modal", "m") + transient("r", jump_reference="m"), "steps[2].jump_reference",
-     "static step"),
+     "'m' is a modal step, not a static step"),
+    (None, transient(jump_reference="kicked"), "steps[1].jump_reference",
+     "'kicked' is the step itself"),
+    (None, transient(jump_reference="after") + static_step("after"), "steps[1].jump_reference",
+     "'after' comes after this step"),
+    # below absolute zero in °C or in K, whichever reference_temperature uses
+    ({"reference_temperature": 15.0}, step("static", temperature=-400.0),
+     "steps[0].temperature", "-400 is below absolute zero"),
+    ({"reference_temperature": 15.0}, step("static", temperature={"c": -273.2}),
+     "steps[0].temperature.c", "below absolute zero"),
+    ({"reference_temperature": 15.0}, step("static", temperature_change=-290.0),
+     "steps[0].temperature_change", "below absolute zero"),
+    ({"reference_temperature": -300.0}, step("static"), "reference_temperature",
+     "below absolute zero"),
 ])
 def test_bad_fields_are_named(top, steps, where, words, tmp_path, capsys):
     path = tmp_path / "bad.toml"

@@ -97,6 +97,10 @@ def test_a_temperature_sweep_is_labelled_and_drawn_per_value(tmp_path, capsys):
     sw = tree["sw"].ds
     assert np.array_equal(sw.attrs["temperature_change"], values)
     assert np.array_equal(sw.attrs["temperature"], np.add(values, 20.0))
+    # and per cable, one row per value (the guy is the only cable)
+    assert sw.temperature.dims == ("sweep", "cable")
+    assert np.array_equal(sw.temperature.values[:, 0], np.add(values, 20.0))
+    assert np.array_equal(sw.temperature_change.values[:, 0], values)
     (_, last), hot = step_values("sw", sw)[-1], tree["hot"].ds
     assert last.attrs["temperature"] == hot.attrs["temperature"] == 30.0
     assert float(last.cable_end_tension.max()) == pytest.approx(
