@@ -279,9 +279,14 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     ds = _static_result(model, state, sol)
     if summary is None:
         return ds
-    from catdae.output.seabed import add_seabed
+    from catdae.output.seabed import add_seabed, sag_into_seabed
 
-    return add_seabed(ds, model.mesh, summary)
+    ds = add_seabed(ds, model.mesh, summary)
+    if model.case.seabed.stiffness is not None:  # contact springs at the nodes (§17.5)
+        sag = sag_into_seabed(ds, model.mesh, model.case.seabed.z)
+        if sag:
+            ds.attrs["note"] = "; ".join(x for x in (ds.attrs.get("note"), sag) if x)
+    return ds
 
 
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:

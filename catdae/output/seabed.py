@@ -20,6 +20,40 @@ def add_seabed(ds: xr.Dataset, mesh, summary: dict) -> xr.Dataset:
     return ds
 
 
+SAG_SHARE = 0.05  # of an element's length: a sag into the seabed between nodes worth a word
+
+
+def sag_into_seabed(ds: xr.Dataset, mesh, zb: float) -> str:
+    """A note ("" when none) for a static state on contact springs in which a cable's lowest
+    point hangs below the seabed and below its lowest node by more than SAG_SHARE of its
+    longest element: the springs act at the nodes only, so an element resting on the seabed
+    with little tension sags into it between them (docs/accuracy.md), and a lying line with a
+    free end folds into loops (an independent tester's 100 m chain: every node on its pinned
+    end)."""
+    if "lowest_point_elevation" not in ds or "cable" not in ds.coords:
+        return ""
+    z = ds.position.sel(axis="z").values
+    order = [list(ds.node.values).index(n) for n in mesh.node_names]
+    z = z[order]
+    worst = None
+    for c, name in enumerate(mesh.cable_names):
+        low = float(ds.lowest_point_elevation.sel(cable=name))
+        els = mesh.cable_of_element == c
+        node_low = float(z[mesh.conn[els]].min())
+        depth = node_low - low
+        if low < zb and depth > SAG_SHARE * float(mesh.L0[els].max()):
+            if worst is None or depth > worst[1]:
+                worst = (name, depth, low, zb - node_low)
+    if worst is None:
+        return ""
+    name, depth, low, pen = worst
+    return (f"cable {name!r} hangs to z = {low:.4g} m, {depth:.3g} m below its lowest node "
+            f"(which sinks {pen:.3g} m into the seabed's springs): the contact springs act at "
+            "the nodes only, so elements lying on the seabed with little tension sag into it "
+            "between them, and a lying line with a free end folds into loops; for statics use "
+            "the rigid seabed (no stiffness), or many more elements (docs/accuracy.md)")
+
+
 def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Dataset:
     """A transient group with ``seabed_length``(time, cable) and ``touchdown``(time, cable,
     axis) at node resolution, from the node positions: nodes at or below the seabed are in

@@ -139,3 +139,46 @@ def test_free_fairlead_finds_the_grounded_equilibrium(elements):
     assert fair == pytest.approx([0.0, 0.0, 0.0], abs=1e-6 * x)
     assert float(ds.seabed_length.item()) == pytest.approx(ref["lying_length"], rel=1e-6)
     assert int(ds.attrs["iterations"]) > 0
+
+
+LAID_CHAIN = """
+[materials.chain]
+EA = 7.5e8
+mass = 110.0
+diameter = 0.17
+[seabed]
+z = 0.0
+{stiffness}
+[nodes]
+A = [0.0, 0.0, 0.0]
+B = [-100.0, 0.0, 0.0]
+[supports]
+A = "pinned"
+[[cables]]
+name = "chain"
+ends = ["A", "B"]
+material = "chain"
+length = 100.0
+elements = 20
+[[steps]]
+kind = "static"
+name = "rest"
+"""
+
+
+def test_a_laid_chain_with_a_free_end_folds_on_contact_springs_and_says_so():
+    """A chain laid straight on the seabed, pinned at one end, free at the other, has no
+    tension: on the rigid seabed it stays straight (its free end 100 m away, tension 0), but the
+    contact springs act at the nodes only, and each tension-free element hangs into the seabed
+    as a loop: a tester found every node folded onto the pinned end with no word of it. The
+    static step's note now says the cable hangs below its nodes, and what to use instead."""
+    rigid = catdae.run(load_case(LAID_CHAIN.format(stiffness="")))["rest"].ds
+    assert float(rigid.position.sel(node="B", axis="x")) == pytest.approx(-100.0, abs=1e-6)
+    assert float(np.abs(rigid.tension).max()) < 1e-6 * 110.0 * 9.81 * 100.0
+    assert "note" not in rigid.attrs
+    springs = catdae.run(load_case(LAID_CHAIN.format(stiffness="stiffness = 1.0e6")))["rest"].ds
+    low = float(springs.lowest_point_elevation.sel(cable="chain"))
+    assert low < -1.0  # the fold: 5 m elements hanging as loops
+    note = springs.attrs["note"]
+    assert "cable 'chain' hangs to z = " in note and "act at the nodes only" in note
+    assert "use the rigid seabed" in note
