@@ -76,6 +76,11 @@ class SeabedPass:
                          f"level [water] surface = {water_surface:g} m: expected a seabed under "
                          "the water (for dry ground leave out [water])")
         if sb.stiffness is None:
+            for key, value in (("friction", axial + lateral), ("damping", sb.damping)):
+                if value:
+                    self.problem(where + (key,), f"{key} acts on the contact springs, in "
+                                 "transient steps: the rigid seabed (no stiffness) is static "
+                                 f"and frictionless; give [seabed] stiffness, or leave out {key}")
             for i, st in enumerate(steps):
                 if st.kind in ("modal", "transient"):
                     self.problem(("steps", i), f"{st.kind} step '{st.name}': a rigid seabed "

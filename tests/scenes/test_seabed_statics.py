@@ -182,3 +182,42 @@ def test_a_laid_chain_with_a_free_end_folds_on_contact_springs_and_says_so():
     note = springs.attrs["note"]
     assert "cable 'chain' hangs to z = " in note and "act at the nodes only" in note
     assert "use the rigid seabed" in note
+
+
+def _spread_toml(ne: int, force: float) -> str:
+    body = "[nodes]\nbody = [0.0, 0.0, -20.0]\n"
+    for i, a in enumerate((0.0, 120.0, 240.0)):
+        body += (f"a{i} = [{800 * math.cos(math.radians(a))}, "
+                 f"{800 * math.sin(math.radians(a))}, -200.0]\n")
+    body += '[supports]\nbody = ["z"]\n' + "".join(f'a{i} = "pinned"\n' for i in range(3))
+    cables = "".join(f'[[cables]]\nname = "L{i}"\nends = ["a{i}", "body"]\nmaterial = "chain"\n'
+                     f"length = 850.0\nelements = {ne}\n" for i in range(3))
+    return ("[materials.chain]\nEA = 7.5e8\nmass = 110.0\ndiameter = 0.17\n"
+            "[water]\ndensity = 1025.0\ndepth = 200.0\n[seabed]\n" + body + cables
+            + f'[[loads]]\nname = "wind"\nnode = "body"\nforce = [{force}, 0.0, 0.0]\n'
+            '[[steps]]\nkind = "static"\nname = "s"\n')
+
+
+def test_a_spread_mooring_pushed_far_matches_moorpy():
+    """Three 850 m chains at 120 degrees to a body held in z only, pushed by 1.0 MN: a tester
+    found the static step failing at 1.0-1.2 MN (10 elements) while 0.8 and 1.3 MN converged:
+    the touchdowns cross elements as the body moves, which Newton at one contact set cannot
+    follow; the loads are now raised in stages. The body's offset is MoorPy's System's."""
+    mp = pytest.importorskip("moorpy")
+    ds = catdae.run(load_case(_spread_toml(10, 1.0e6)))["s"].ds
+    off = ds.position.sel(node="body").values
+    ms = mp.System(depth=200.0, rho=1025.0, g=9.81)
+    w = (110.0 - 1025.0 * math.pi * 0.17**2 / 4) * 9.81
+    ms.lineTypes["chain"] = dict(name="chain", d_vol=0.17, m=110.0, EA=7.5e8, w=w,
+                                 material="c", d_nom=0.17, MBL=1e9, Cd=1, Ca=1, CdAx=0, CaAx=0,
+                                 cost=0)
+    ms.addPoint(0, [0, 0, -20.0], DOFs=[0, 1])
+    for a in (0.0, 120.0, 240.0):
+        ms.addPoint(1, [800 * math.cos(math.radians(a)), 800 * math.sin(math.radians(a)),
+                        -200.0])
+        ms.addLine(850.0, "chain", pointA=len(ms.pointList), pointB=1)
+    ms.initialize()
+    ms.pointList[0].fExt = np.array([1.0e6, 0.0, 0.0])
+    ms.solveEquilibrium(tol=1e-7, maxIter=5000)
+    np.testing.assert_allclose(off[:2], ms.pointList[0].r[:2], rtol=0, atol=1e-6)
+    assert off[0] > 20.0  # pushed far: the chain towards the load lies on the seabed longer

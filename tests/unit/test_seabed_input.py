@@ -55,6 +55,9 @@ def scene(seabed: dict, steps: str | None = None, diameter: bool = True) -> str:
     ({"z": -20.0, "friction_velocity": 0.0}, "seabed.friction_velocity",
      "expected a value > 0"),
     ({"stiffness": 1e5}, "seabed.z", "give the height of the seabed"),
+    # a rigid seabed is static and frictionless: friction and damping there did nothing
+    ({"z": -20.0, "friction": 0.5}, "seabed.friction", "the rigid seabed (no stiffness)"),
+    ({"z": -20.0, "damping": 2.0e4}, "seabed.damping", "give [seabed] stiffness, or leave out"),
     ({"z": -20.0, "roughness": 2}, "seabed.roughness", ""),
 ])
 def test_bad_seabed_fields(seabed, field, expected, tmp_path, capsys):
