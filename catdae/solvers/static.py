@@ -85,7 +85,8 @@ def solve_static(model: Model, X: np.ndarray, h0: np.ndarray | None = None, t: f
         if dlam < 1e-6 or not (model.has_internal_loads or np.any(p_full)):
             model.elements.set_load_forces(f_full)
             raise ConvergenceError(
-                f"static equilibrium not found: load factor stuck at {lam:.6g} "
+                f"static equilibrium not found: the step's loads ramped up to "
+                f"{100 * lam:.4g} % of their full value, no further "
                 f"(|R| = {rnorm:.3g} N after {total_iter} Newton iterations"
                 f"{_largest_residual(model, X_new, state_new, p)})")
     r = _residual(model, state, p_full, X)
