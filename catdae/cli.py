@@ -22,7 +22,7 @@ from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CaseError, CatdaeError, InternalError, OutputError, ResultsError
 from catdae.interrupts import signals_as_interrupts
 from catdae.output.files import check_folder
-from catdae.output.summary import summary
+from catdae.output.summary import step_summary, summary  # noqa: F401 (catdae.cli.summary)
 from catdae.progress import say
 
 # catdae.output.plot.WHAT
@@ -174,11 +174,18 @@ def _run(args) -> int:
         return 2
     from catdae.progress import announce_compiling
 
+    say(case.title or "catdae run")
+
+    def finished(name, ds):  # each step's summary as it ends: an interrupted run has them
+        text = step_summary(name, ds)
+        if text:
+            say(text)
+
     try:
         with announce_compiling():  # whenever numba compiles, the first time is announced
             tree = run(case, output=out, progress=args.progress, rtol=args.rtol,
                        atol=args.atol, elements=args.elements, mass_model=args.mass_model,
-                       max_order=args.max_order)
+                       max_order=args.max_order, on_group=finished)
     except CaseError:
         raise  # an invalid override (exit 2), reported by main
     except CatdaeError as exc:
@@ -187,7 +194,6 @@ def _run(args) -> int:
             traceback.print_exception(exc.__cause__, file=sys.stderr)
         _say_where(exc, "before the failure")
         return 1
-    say(summary(tree))
     say(f"results written to {out}")
     if args.vtk:
         from catdae.output.export import write_vtk

@@ -26,7 +26,7 @@ MAX_SIDE = 101  # points per side of a water-surface grid at most
 def environment_attrs(case) -> dict:
     """The attributes of every step group of ``case`` (module docstring); {} without water and
     seabed."""
-    up = np.array([-float(g) for g in case.gravity_direction])
+    up = np.array([-float(g) for g in case.gravity_direction]) + 0.0  # + 0.0: no "-0"
     if case.water is None and case.seabed is None:
         # a gravity vector alone: ``up``, so that the profile figure draws heights upwards
         return {} if np.array_equal(up, (0.0, 0.0, 1.0)) else {"up": up}

@@ -29,6 +29,7 @@ back (a table file no longer where it was), the still-water plane stands in for 
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -153,12 +154,24 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str, case=None) 
     entries = [f'    <DataSet timestep="{float(t)!r}" part="{p}" '
                f'file={quoteattr(fs[min(k, len(fs) - 1)].relative_to(folder).as_posix())}/>'
                for k, t in enumerate(times) for p, fs in enumerate(parts)]
+    _drop_stale(sub, name, {f for fs in parts for f in fs})
     pvd = folder / f"{name}.pvd"
     with deferred():
         pvd.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
                        "  <Collection>\n" + "\n".join(entries)
                        + "\n  </Collection>\n</VTKFile>\n")
     return pvd
+
+
+def _drop_stale(sub: Path, name: str, written: set[Path]) -> None:
+    """Remove the files of an earlier export of the same step that this one did not write (a
+    longer run's later times): ParaView's grouping of numbered files would mix them in. Only
+    files named as this export names them (``<name>_00012.vtu``, ``<name>_water_00012.vtu``,
+    ``<name>_seabed.vtu``) in the step's own folder."""
+    pattern = re.compile(re.escape(name) + r"_((water_)?\d{5}|seabed)\.vtu")
+    for f in sub.glob("*.vtu"):
+        if f not in written and pattern.fullmatch(f.name):
+            f.unlink(missing_ok=True)
 
 
 def write_vtk(tree: xr.DataTree, folder: str | os.PathLike, steps=None) -> list[Path]:

@@ -13,14 +13,19 @@ def summary(tree) -> str:
     """A short printed summary: per step, what a user looks at first (per value of a sweep)."""
     lines = [f"{tree.attrs.get('title') or 'catdae run'}"]
     for name, node in tree.children.items():
-        ds = node.to_dataset()
-        if "sweep" not in ds.dims:
-            lines.extend(_step_lines(name, ds))
-            continue
-        field = ds.attrs.get("sweep_field", "sweep")
-        lines.append(f"[{name}] swept over {field}: {ds.sizes['sweep']} values")
-        for _, one in step_values(name, ds):
-            lines.extend(_step_lines(f"{name} {one.attrs['sweep_value']}", one))
+        lines.append(step_summary(name, node.to_dataset()))
+    return "\n".join(x for x in lines if x)
+
+
+def step_summary(name: str, ds) -> str:
+    """The summary of one step's group (``catdae run`` prints it as the step ends, so that an
+    interrupted or failed run has printed the steps it finished)."""
+    if "sweep" not in ds.dims:
+        return "\n".join(_step_lines(name, ds))
+    field = ds.attrs.get("sweep_field", "sweep")
+    lines = [f"[{name}] swept over {field}: {ds.sizes['sweep']} values"]
+    for _, one in step_values(name, ds):
+        lines.extend(_step_lines(f"{name} {one.attrs['sweep_value']}", one))
     return "\n".join(lines)
 
 
@@ -155,9 +160,12 @@ def _span_lines(ds, k: int) -> list[str]:
     """The span quantities of cable k (catdae.output.engineering), when the group has them."""
     if "sag_midspan" not in ds:
         return []
-    parts = [f"sag at midspan {float(ds.sag_midspan.values[k]):.6g} m",
-             f"at the lowest point {float(ds.sag_lowest_point.values[k]):.6g} m below the lower "
-             "end",
+    mid = float(ds.sag_midspan.values[k])
+    low = float(ds.sag_lowest_point.values[k])
+    if abs(low) < 1e-9 * max(abs(mid), 1.0):  # rounding of a lowest point at the end: 0
+        low = 0.0
+    parts = [f"sag at midspan {mid:.6g} m",
+             f"at the lowest point {low:.6g} m below the lower end",
              f"swing angle {_deg(float(ds.swing_angle.values[k]))} deg"]
     if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
         parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % of "

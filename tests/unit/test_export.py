@@ -3,6 +3,7 @@ positions, the elements and the tensions of every output time, and the collectio
 
 from __future__ import annotations
 
+import dataclasses
 import xml.etree.ElementTree as ET
 
 import meshio
@@ -52,3 +53,30 @@ def test_run_with_vtk_writes_the_collections(tmp_path):
     assert sorted(kinds.values()) == ["modal", "static", "static", "transient"]
     expected = {n for n, k in kinds.items() if k != "modal"}
     assert {p.stem for p in (tmp_path / "vtk").glob("*.pvd")} == expected
+
+
+def test_a_second_export_into_the_folder_leaves_no_files_of_the_first(tmp_path, capsys):
+    """A tester exported a longer run, then a shorter one into the same folder: 401 files on
+    disk against 101 in the collection, which ParaView's grouping of numbered files mixes.
+    The step's folder now holds exactly the files its collection names (a user's own file
+    there is left alone)."""
+    from catdae.output.export import write_vtk
+
+    base = (CASES / "example2_support_motion_gentle.toml").read_text()
+    trees = [catdae.run(catdae.load_case(base), elements=4, rtol=1e-4, progress=False)]
+    case = catdae.load_case(base)
+    short = tuple(dataclasses.replace(s, duration=s.duration / 2) if s.kind == "transient"
+                  else s for s in case.steps)
+    trees.append(catdae.run(dataclasses.replace(case, steps=short), elements=4, rtol=1e-4,
+                            progress=False))
+    folder = tmp_path / "vtk"
+    write_vtk(trees[0], folder)
+    mine = folder / "excitation" / "notes.vtu"
+    mine.write_text("a user's file")
+    write_vtk(trees[1], folder)
+    sets = ET.parse(folder / "excitation.pvd").getroot().findall("./Collection/DataSet")
+    named = {(folder / s.get("file")).resolve() for s in sets}
+    on_disk = {p.resolve() for p in (folder / "excitation").glob("*.vtu")} - {mine.resolve()}
+    assert on_disk == named
+    assert len(named) == trees[1]["excitation"].to_dataset().sizes["time"]
+    assert mine.exists()
