@@ -174,9 +174,11 @@ def _run(args) -> int:
         return 2
     from catdae.progress import announce_compiling
 
-    say(case.title or "catdae run")
+    titled = []
 
     def finished(name, ds):  # each step's summary as it ends: an interrupted run has them
+        if not titled:
+            titled.append(say(case.title or "catdae run"))
         text = step_summary(name, ds)
         if text:
             say(text)

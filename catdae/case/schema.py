@@ -24,6 +24,9 @@ from catdae.case.limits import (
 STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, defer_build=True)
 
 Pos = Annotated[float, Field(gt=0)]
+# a relative tolerance: above 0.1 an error test accepts errors as large as the motion (a tester's
+# rtol = 5, a slip for 5e-3, reported 4.5e9 N for 12 kN with no word)
+Rtol = Annotated[float, Field(gt=0, le=0.1)]
 NonNeg = Annotated[float, Field(ge=0)]
 Time = Annotated[float, Field(ge=MIN_TIME)]  # s: shorter is degenerate (0/0 in a ramp)
 Frequency = Annotated[float, Field(gt=0, le=MAX_FREQUENCY)]
@@ -166,7 +169,7 @@ class _TransientStep(BaseModel):
     add: list[Name] = []
     duration: Time
     output_interval: Time
-    rtol: Pos = 1e-6
+    rtol: Rtol = 1e-6
     atol: Pos = 1e-8
     damping: TomlTable | None = None
     max_order: Any = "auto"  # "auto" or an integer 1-5 (checked by the builder)
@@ -292,7 +295,7 @@ class OverridesSchema(BaseModel):
     of ``catdae.run``) may replace, typed as the case file's own fields."""
 
     model_config = STRICT
-    rtol: Pos | None = None  # as a transient step's rtol
+    rtol: Rtol | None = None  # as a transient step's rtol
     atol: Pos | None = None  # as a transient step's atol
     elements: Elements | None = None  # as a cable's elements
     mass_model: MassModelName | None = None  # as a modal or transient step's mass_model
