@@ -76,4 +76,8 @@ def gain_note(model, prob, rec, n_valid: int) -> str:
             f"{GAIN_LIMIT:g} of it from t = {first:.6g} s): the run is not following its "
             "equations there (in the cases seen, an element's undamped axial ringing grows) "
             "and its tensions are not reliable; add axial_damping (e.g. { ratio = 0.5 }) or "
-            "tighten rtol (docs/theory.md §13.6)")
+            "tighten rtol (docs/theory.md §13.6)"
+            + ("; where the line snaps taut, mass_model = \"lumped\", which carries the "
+               "snap's axial wave, is the one that gets the peak tension right (an independent "
+               "tester's sagging span driven into snaps: +80 % with the blended mass)"
+               if model.mass_model.catenary else ""))
