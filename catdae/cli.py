@@ -87,6 +87,8 @@ def _parser() -> argparse.ArgumentParser:
                     help="steps to export (default: every static and transient step)")
     c = sub.add_parser("check", help="validate a case file and report every problem")
     c.add_argument("case")
+    c.add_argument("--elements", type=int, help="elements per cable, as catdae run takes it "
+                   "(the checks that depend on the mesh, such as connectors on mesh nodes)")
     s = sub.add_parser("study", help="accuracy and cost studies (work-precision)",
                        add_help=False)  # `catdae study -h` is answered by catdae.study
     s.add_argument("rest", nargs=argparse.REMAINDER)
@@ -153,6 +155,8 @@ def _check(args) -> int:
     from catdae.case import load_case
 
     case = load_case(Path(args.case))  # the command line always names a file
+    if args.elements is not None:  # as catdae run --elements would mesh it
+        case = case.with_overrides(elements=args.elements)
     mesh = check_case(case)
     say(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
         f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")

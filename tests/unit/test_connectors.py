@@ -212,6 +212,20 @@ def test_more_elements_keep_a_connector_on_its_mesh_node(tmp_path):
         midspan.with_overrides(elements=3)
 
 
+def test_catdae_check_takes_elements_as_run_does(tmp_path, capsys):
+    """``catdae check --elements N`` judges the case meshed as ``catdae run --elements N``
+    would (a tester found no way to check a mesh before running it): a spring on c.2 of 4
+    elements needs an even count."""
+    from catdae.cli import main
+
+    f = tmp_path / "midspan.toml"
+    f.write_text(bad(spring("k", ["c.2", "G"], 1.0)))
+    assert main(["check", str(f), "--elements", "6"]) == 0
+    assert "6 elements" in capsys.readouterr().out
+    assert main(["check", str(f), "--elements", "3"]) == 2
+    assert "use a multiple of 2 elements" in capsys.readouterr().err
+
+
 def test_a_misspelt_connector_end_is_the_only_message(tmp_path, capsys):
     """The node the spring was meant to hold (with a point mass on it) is not reported as held
     by nothing: those would follow from the misspelling, which is reported with its fix."""
