@@ -282,11 +282,10 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     from catdae.output.seabed import add_seabed, sag_into_seabed
 
     ds = add_seabed(ds, model.mesh, summary)
-    if model.case.seabed.stiffness is not None:  # contact springs at the nodes (§17.5)
-        sag = sag_into_seabed(ds, model.mesh, model.case.seabed.z)
-        if sag:
-            ds.attrs["note"] = "; ".join(x for x in (ds.attrs.get("note"), sag) if x)
-    return ds
+    if model.case.seabed.stiffness is None:
+        return ds
+    # contact springs at the nodes (§17.5)
+    return results.with_note(ds, sag_into_seabed(ds, model.mesh, model.case.seabed.z))
 
 
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
@@ -308,9 +307,8 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
             f"{100 * np.nanmax(strain[e]):.3g} % (T / EA): far beyond what a cable carries "
             f"(the case check refuses {100 * MAX_STRAIN:g} % in the geometry); check the "
             "loads and their units")
-    fast = plausibility_note(model.case, waves=False) if model.fluid is not None else ""
-    if fast:
-        ds.attrs["note"] = "; ".join(x for x in (ds.attrs.get("note"), fast) if x)
+    if model.fluid is not None:
+        ds = results.with_note(ds, plausibility_note(model.case, waves=False))
     return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
                                   engineering.rated_strengths(model.case, model.mesh.cable_names))
 

@@ -36,15 +36,15 @@ def default_case_path() -> Path:
     return Path(str(files("catdae") / "data" / DEFAULT_CASE))
 
 
-def _order(text: str) -> int | str:
-    """``--max-order``: "auto" or an integer (its range is judged with the case's own field)."""
+def max_order_arg(text: str) -> int | str:
+    """``--max-order`` of ``catdae run`` and ``catdae study``: "auto" or an integer (its range
+    is judged with the case's own field)."""
     if text == "auto":
         return text
     try:
         return int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f'expected "auto" or an integer 1-5, got {text!r}') \
-            from None
+        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}") from None
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -58,7 +58,7 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("--rtol", type=float, help="relative tolerance of transient steps")
     r.add_argument("--atol", type=float, help="absolute tolerance of transient steps, m")
     r.add_argument("--elements", type=int, help="elements per cable")
-    r.add_argument("--max-order", type=_order, metavar="{auto,1,2,3,4,5}",
+    r.add_argument("--max-order", type=max_order_arg, metavar="{auto,1,2,3,4,5}",
                    help="largest BDF order of transient steps (2: A-stable, damps what it does "
                         "not resolve)")
     r.add_argument("--mass-model", choices=MASS_MODEL_NAMES,

@@ -51,11 +51,10 @@ def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarra
         return out
     u = np.nan_to_num(undamped.reshape(undamped.shape[0], -1))
     d = np.nan_to_num(damped.reshape(damped.shape[0], -1))[:n]
-    if d.size and u.size:
-        num = np.abs(d.conj() @ u.T) ** 2
-        den = np.outer(np.einsum("ij,ij->i", d.conj(), d).real, np.einsum("ij,ij->i", u, u))
-        mac = num / np.where(den > 0, den, 1.0)
-        out[:d.shape[0]] = np.argmax(mac, axis=1) + 1
+    num = np.abs(d.conj() @ u.T) ** 2
+    den = np.outer(np.einsum("ij,ij->i", d.conj(), d).real, np.einsum("ij,ij->i", u, u))
+    mac = num / np.where(den > 0, den, 1.0)
+    out[:d.shape[0]] = np.argmax(mac, axis=1) + 1
     return out
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
+from catdae.output.results import with_note
 
 _EPS = 1e-9  # a time within this (relative to the step's clock) of its end is at its end
 
@@ -89,7 +90,6 @@ def with_end_note(ds: xr.Dataset) -> xr.Dataset:
     peaks = end_peaks(ds)
     if not peaks:
         return ds
-    said = (f"reached at the step's last output time (t = {float(ds.time.values[-1]):.6g} s), "
-            f"so they may still be growing (a longer step shows the peak): {'; '.join(peaks)}")
-    note = ds.attrs.get("note", "")
-    return ds.assign_attrs(note=f"{note}; {said}" if note else said)
+    return with_note(ds, f"reached at the step's last output time (t = "
+                     f"{float(ds.time.values[-1]):.6g} s), so they may still be growing (a "
+                     f"longer step shows the peak): {'; '.join(peaks)}")

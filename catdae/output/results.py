@@ -86,6 +86,15 @@ def clean_attrs(attrs: dict) -> dict:
     return out
 
 
+def with_note(ds: xr.Dataset, text: str) -> xr.Dataset:
+    """``ds`` with ``text`` added to its ``note`` attribute (advice on the result, joined by
+    "; "); ``ds`` itself when ``text`` is empty."""
+    if not text:
+        return ds
+    note = ds.attrs.get("note", "")
+    return ds.assign_attrs(note=f"{note}; {text}" if note else text)
+
+
 def static_dataset(mesh: Mesh, X: np.ndarray, tension: np.ndarray, reaction: np.ndarray,
                    attrs: dict, cables: dict | None = None) -> xr.Dataset:
     """One static step: positions (n_nodes, 3), tensions (n_elem, 2), reactions (n_nodes, 3).

@@ -32,9 +32,7 @@ def sag_into_seabed(ds: xr.Dataset, mesh, zb: float) -> str:
     end)."""
     if "lowest_point_elevation" not in ds or "cable" not in ds.coords:
         return ""
-    z = ds.position.sel(axis="z").values
-    order = [list(ds.node.values).index(n) for n in mesh.node_names]
-    z = z[order]
+    z = ds.position.sel(axis="z", node=list(mesh.node_names)).values  # in mesh order
     worst = None
     for c, name in enumerate(mesh.cable_names):
         low = float(ds.lowest_point_elevation.sel(cable=name))

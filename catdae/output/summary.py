@@ -145,15 +145,21 @@ def _jump_lines(ds) -> list[str]:
                          f"'{ds.attrs.get('jump_reference', '')}' at t = {when:.6g} s"
                          + (" (at the step's end: may still be rising)" if at_end(when, ds)
                             else "") + f", s = {float(ds.jump_s.values[k]):.6g} m")
-        if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
-            parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % "
-                         "of rated strength")
+        parts += _rated(ds, k)
         if "clearance_time" in ds:
             parts.append(f"least clearance {float(ds.clearance.values[k]):.6g} m at t = "
                          f"{float(ds.clearance_time.values[k]):.6g} s")
         if parts:
             out.append(f"    cable {cab}: " + "; ".join(parts))
     return out
+
+
+def _rated(ds, k: int) -> list[str]:
+    """Cable k's largest tension as a percentage of its rated strength, when it has one."""
+    if "tension_percent_rated" not in ds or not np.isfinite(ds.tension_percent_rated.values[k]):
+        return []
+    return [f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % of rated "
+            "strength"]
 
 
 def _span_lines(ds, k: int) -> list[str]:
@@ -167,9 +173,7 @@ def _span_lines(ds, k: int) -> list[str]:
     parts = [f"sag at midspan {mid:.6g} m",
              f"at the lowest point {low:.6g} m below the lower end",
              f"swing angle {_deg(float(ds.swing_angle.values[k]))} deg"]
-    if "tension_percent_rated" in ds and np.isfinite(ds.tension_percent_rated.values[k]):
-        parts.append(f"largest tension {float(ds.tension_percent_rated.values[k]):.4g} % of "
-                     "rated strength")
+    parts += _rated(ds, k)
     if "clearance" in ds:
         parts.append(f"clearance above the ground {float(ds.clearance.values[k]):.6g} m at "
                      f"s = {float(ds.clearance_s.values[k]):.6g} m")

@@ -107,14 +107,14 @@ def fluid_flow(model: Model, X: np.ndarray):
     return kx.copy(), kv.copy()
 
 
-def damping_matrix(model: Model, X: np.ndarray, state: ElementState,
-                   damping) -> sp.csr_matrix | None:
-    """C on the full dof set about positions X: the dampers' c e eᵀ, and the step's ``damping``
+def damping_matrix(model: Model, X: np.ndarray, state: ElementState, damping,
+                   flow=None) -> sp.csr_matrix | None:
+    """C on the full dof set about positions X: the dampers' c e eᵀ, the step's ``damping``
     (material: the cables' damping per length with the mass model's interpolation; Rayleigh:
-    α M + β K). None when the scene has no damping at all."""
+    α M + β K) and the fluid's ``flow`` (:func:`fluid_flow`). None when the scene has no
+    damping at all."""
     cn = model.connectors
     has_dampers = cn is not None and "damper" in cn.kinds  # (a sweep may start at c = 0)
-    flow = fluid_flow(model, X)
     if damping is None and not has_dampers and flow is None:
         return None
     data = np.zeros(model.pattern.nnz)
@@ -142,15 +142,15 @@ def solve_damped(model: Model, X: np.ndarray, state: ElementState, n_modes: int,
                  damping) -> tuple[DampedModes, np.ndarray] | None:
     """The damped modes about (X, state), or None when the scene has no damping. Returns the
     modes and their complex shapes on the nodes, (n_modes, n_nodes, 3)."""
-    c = damping_matrix(model, X, state, damping)
+    flow = fluid_flow(model, X)  # one fluid pass for C and K
+    c = damping_matrix(model, X, state, damping, flow)
     if c is None:
         return None
     free = model.free
-    k = model.stiffness(state, X)
-    flow = fluid_flow(model, X)
+    k = model.stiffness_data(state, X)
     if flow is not None:  # the drag's stiffness in the flow, as the static Newton has it
-        k = k + model.pattern.matrix(model.pattern.assemble(flow[0]))
-    k = k[free][:, free]
+        k = k + model.pattern.assemble(flow[0])
+    k = model.pattern.matrix(k)[free][:, free]
     m = model.mass(state)
     if model.fluid is not None:  # the added mass of the water, as in the undamped modes
         m = m + model.pattern.matrix(model.pattern.assemble(model.fluid.mass(X)))

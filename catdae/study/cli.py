@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from catdae.cli import max_order_arg as _order
 from catdae.errors import CaseError, OutputError
 from catdae.study.core import CHOICES, StudyError
 from catdae.study.report import summary, write_study
@@ -172,13 +173,3 @@ def _interrupted(exc: KeyboardInterrupt, out: Path | None, store: Path | None) -
     if store is not None:
         print(f"catdae study: finished runs are kept in {store}", file=sys.stderr)
     return code
-
-
-def _order(text: str) -> int | str:
-    """A --max-order value: "auto" (the default of a transient step) or an integer."""
-    if text == "auto":
-        return text
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}") from None
