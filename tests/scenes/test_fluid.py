@@ -21,7 +21,16 @@ from catdae.solvers.residual import TransientProblem
 from catdae.solvers.static import solve_static
 
 from reference import irvine_catenary_inclined_3d
-from scene_toml import cable_scene, modal_step, static_step, transient_step
+from scene_toml import (
+    cable,
+    cable_scene,
+    modal_step,
+    scene,
+    section,
+    static_step,
+    step,
+    transient_step,
+)
 
 RHO = 1025.0
 G = 9.81
@@ -306,13 +315,15 @@ def test_damped_modes_in_a_steady_wind_carry_the_aerodynamic_damping():
     step has no damping and no damped modes at all."""
     span, tension, EA, m, d, cd, rho, U, ne = 100.0, 1.0e5, 1.0e8, 2.0, 0.03, 1.0, 1.25, 20.0, 40
     L0 = span / (1 + tension / EA)
-    extra = f"[air]\ndensity = {rho}\nwind = [0.0, {U}, 0.0]\n"
-    text = cable_scene(A=(0, 0, 10), B=(span, 0, 10), L0=L0, EA=EA, mass=m, elements=ne,
-                       gravity=0.0, extra=extra, steps=static_step() + (
-                           '[[steps]]\nkind = "modal"\nname = "m"\nmodes = 6\n'
-                           'mass_model = "consistent"\n'))
-    text = text.replace(f"mass = {m}\n", f"mass = {m}\ndiameter = {d}\ndrag_normal = {cd}\n"
-                        "drag_axial = 0.0\n")
+
+    def in_wind(speed):
+        return cable_scene(A=(0, 0, 10), B=(span, 0, 10), L0=L0, EA=EA, mass=m, elements=ne,
+                           gravity=0.0,
+                           properties={"diameter": d, "drag_normal": cd, "drag_axial": 0.0},
+                           extra=section("air", density=rho, wind=[0.0, speed, 0.0]),
+                           steps=static_step() + modal_step(6, "m", "consistent"))
+
+    text = in_wind(U)
     ds = catdae.run(load_case(text), progress=False)["m"].to_dataset()
     assert "damping_ratio" in ds
     mu = m * L0 / span
@@ -323,8 +334,7 @@ def test_damped_modes_in_a_steady_wind_carry_the_aerodynamic_damping():
         share = 1.0 if along else 0.5
         expected = share * rho * cd * d * U / (2.0 * mu * omega)
         assert float(ds.damping_ratio[k]) == pytest.approx(expected, rel=5e-3)
-    still = catdae.run(load_case(text.replace(f"wind = [0.0, {U}, 0.0]", "wind = [0.0, 0.0, 0.0]")),
-                       progress=False)["m"].to_dataset()
+    still = catdae.run(load_case(in_wind(0.0)), progress=False)["m"].to_dataset()
     assert "damping_ratio" not in still
 
 
@@ -443,39 +453,17 @@ def test_drag_through_the_surface_only_takes_energy(mass_model):
     assert min(powers) < 0.0
 
 
-def _riser(waves: str, current: str = "") -> str:
-    """A taut riser from a 60 m deep floor to 2 m below the surface, 6 elements."""
-    return f"""
-[materials.riser]
-EA = 1.0e10
-mass = 300.0
-diameter = 0.5
-[water]
-density = 1025.0
-depth = 60.0
-{waves}
-{current}
-[nodes]
-bottom = [0.0, 0.0, -60.0]
-top = [0.0, 0.0, -2.0]
-[supports]
-bottom = "pinned"
-top = "pinned"
-[[cables]]
-name = "riser"
-ends = ["bottom", "top"]
-material = "riser"
-length = 57.99
-elements = 6
-[[steps]]
-kind = "static"
-name = "still"
-[[steps]]
-kind = "transient"
-name = "waves"
-duration = 0.05
-output_interval = 0.05
-"""
+def _riser(waves=None, current=None) -> str:
+    """A taut riser from a 60 m deep floor to 2 m below the surface, 6 elements, in 60 m of
+    water with ``waves`` and ``current`` (fields of [water]); a static step, then 0.05 s."""
+    return scene(materials={"riser": {"EA": 1.0e10, "mass": 300.0, "diameter": 0.5}},
+                 nodes={"bottom": (0.0, 0.0, -60.0), "top": (0.0, 0.0, -2.0)},
+                 supports=("bottom", "top"),
+                 cables=cable("riser", ("bottom", "top"), "riser", 57.99, 6),
+                 extra=section("water", density=1025.0, depth=60.0, waves=waves,
+                               current=current),
+                 steps=static_step("still") + step("transient", "waves", duration=0.05,
+                                                   output_interval=0.05))
 
 
 @pytest.mark.parametrize("height, breaking", [(30.0, False), (40.0, True)])
@@ -489,7 +477,7 @@ def test_a_wave_beyond_breaking_is_noted(height, breaking):
     k = brentq(lambda k: G * k * math.tanh(k * 60.0) - w * w, 1e-6, 1.0)
     limit = 0.142 * 2 * math.pi / k * math.tanh(k * 60.0)
     assert 30.0 < limit < 40.0
-    text = _riser(f'waves = {{ kind = "airy", height = {height}, period = 14.0 }}')
+    text = _riser(waves={"kind": "airy", "height": height, "period": 14.0})
     tree = catdae.run(load_case(text))
     note = tree["waves"].ds.attrs.get("note", "")
     assert ("above the breaking limit" in note) == breaking
@@ -501,9 +489,9 @@ def test_a_wave_beyond_breaking_is_noted(height, breaking):
 def test_a_current_faster_than_any_sea_is_noted_and_a_nan_one_shown():
     """A current of 12 m/s (a slip of units) is named in the static note; a NaN component is
     shown in the message as it was given (it said only "an array of 3 items")."""
-    tree = catdae.run(load_case(_riser("", "current = [12.0, 0.0, 0.0]")))
+    tree = catdae.run(load_case(_riser(current=[12.0, 0.0, 0.0])))
     assert "the current reaches 12 m/s" in tree["still"].ds.attrs["note"]
-    calm = catdae.run(load_case(_riser("", "current = [1.5, 0.0, 0.0]")))
+    calm = catdae.run(load_case(_riser(current=[1.5, 0.0, 0.0])))
     assert "note" not in calm["still"].ds.attrs
     with pytest.raises(catdae.CaseError, match=r"found the array \[nan, 0\.0, 0\.0\]"):
-        load_case(_riser("", "current = [nan, 0.0, 0.0]"))
+        load_case(_riser(current=[math.nan, 0.0, 0.0]))

@@ -600,37 +600,11 @@ def test_a_modal_step_after_a_transient_says_its_state_is_not_an_equilibrium():
                                                       rel=1e-3)
 
 
-MASS_OFF_MIDSPAN = """
-[materials.w]
-EA = 1.0e7
-mass = 1.0
-weight = 0.5
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [20.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "w"
-length = 19.99
-elements = 40
-[[point_masses]]
-name = "m"
-cable = "c"
-s = S_MASS
-mass = 5.0
-[[steps]]
-kind = "static"
-name = "s0"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 8
-mass_model = "consistent"
-"""
+def mass_off_midspan(a: float) -> str:
+    """A taut 20 m string (40 elements) with a 5 kg mass at arc length ``a``: its modes."""
+    return cable_scene(B=(20.0, 0.0, 0.0), L0=19.99, EA=1.0e7, mass=1.0, weight=0.5,
+                       elements=40, material="w", extra=point_mass("m", 5.0, cable="c", s=a),
+                       steps=static_step("s0") + modal_step(8, mass_model="consistent"))
 
 
 @pytest.mark.parametrize("a", [6.0, 10.0])
@@ -640,7 +614,7 @@ def test_symmetry_labels_of_a_string_with_a_mass_off_midspan_follow_the_closed_f
     A tester found a mass at 30 % of the span labelled "symmetric" at 82 % symmetry. The share
     of each mode's squares in its mirror-symmetric part, from the closed form, says "symmetric"
     or "antisymmetric" at 90 % or more, else "mixed"; with the mass at midspan no mode mixes."""
-    tree = catdae.run(catdae.load_case(MASS_OFF_MIDSPAN.replace("S_MASS", str(a))))
+    tree = catdae.run(catdae.load_case(mass_off_midspan(a)))
     ds = tree["modes"].ds
     H = float(tree["s0"].ds.horizontal_tension[0])
     L, M = 20.0, 5.0

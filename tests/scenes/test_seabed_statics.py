@@ -18,7 +18,7 @@ import catdae
 from catdae.case import load_case
 
 from reference import grounded_catenary
-from scene_toml import cable, load, scene, section
+from scene_toml import cable, load, scene, section, static_step
 
 EA = 1.674e9
 MASS = 390.0
@@ -141,29 +141,13 @@ def test_free_fairlead_finds_the_grounded_equilibrium(elements):
     assert int(ds.attrs["iterations"]) > 0
 
 
-LAID_CHAIN = """
-[materials.chain]
-EA = 7.5e8
-mass = 110.0
-diameter = 0.17
-[seabed]
-z = 0.0
-{stiffness}
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [-100.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-[[cables]]
-name = "chain"
-ends = ["A", "B"]
-material = "chain"
-length = 100.0
-elements = 20
-[[steps]]
-kind = "static"
-name = "rest"
-"""
+def laid_chain(stiffness=None) -> str:
+    """A 100 m chain laid straight on the seabed at z = 0, pinned at A, its end B free; a rigid
+    seabed without ``stiffness``, contact springs with it."""
+    return scene(materials={"chain": {"EA": 7.5e8, "mass": 110.0, "diameter": 0.17}},
+                 nodes={"A": (0.0, 0.0, 0.0), "B": (-100.0, 0.0, 0.0)}, supports=("A",),
+                 cables=cable("chain", ("A", "B"), "chain", 100.0, 20),
+                 extra=section("seabed", z=0.0, stiffness=stiffness), steps=static_step("rest"))
 
 
 def test_a_laid_chain_with_a_free_end_folds_on_contact_springs_and_says_so():
@@ -172,11 +156,11 @@ def test_a_laid_chain_with_a_free_end_folds_on_contact_springs_and_says_so():
     contact springs act at the nodes only, and each tension-free element hangs into the seabed
     as a loop: a tester found every node folded onto the pinned end with no word of it. The
     static step's note now says the cable hangs below its nodes, and what to use instead."""
-    rigid = catdae.run(load_case(LAID_CHAIN.format(stiffness="")))["rest"].ds
+    rigid = catdae.run(load_case(laid_chain()))["rest"].ds
     assert float(rigid.position.sel(node="B", axis="x")) == pytest.approx(-100.0, abs=1e-6)
     assert float(np.abs(rigid.tension).max()) < 1e-6 * 110.0 * 9.81 * 100.0
     assert "note" not in rigid.attrs
-    springs = catdae.run(load_case(LAID_CHAIN.format(stiffness="stiffness = 1.0e6")))["rest"].ds
+    springs = catdae.run(load_case(laid_chain(1.0e6)))["rest"].ds
     low = float(springs.lowest_point_elevation.sel(cable="chain"))
     assert low < -1.0  # the fold: 5 m elements hanging as loops
     note = springs.attrs["note"]
@@ -185,17 +169,18 @@ def test_a_laid_chain_with_a_free_end_folds_on_contact_springs_and_says_so():
 
 
 def _spread_toml(ne: int, force: float) -> str:
-    body = "[nodes]\nbody = [0.0, 0.0, -20.0]\n"
-    for i, a in enumerate((0.0, 120.0, 240.0)):
-        body += (f"a{i} = [{800 * math.cos(math.radians(a))}, "
-                 f"{800 * math.sin(math.radians(a))}, -200.0]\n")
-    body += '[supports]\nbody = ["z"]\n' + "".join(f'a{i} = "pinned"\n' for i in range(3))
-    cables = "".join(f'[[cables]]\nname = "L{i}"\nends = ["a{i}", "body"]\nmaterial = "chain"\n'
-                     f"length = 850.0\nelements = {ne}\n" for i in range(3))
-    return ("[materials.chain]\nEA = 7.5e8\nmass = 110.0\ndiameter = 0.17\n"
-            "[water]\ndensity = 1025.0\ndepth = 200.0\n[seabed]\n" + body + cables
-            + f'[[loads]]\nname = "wind"\nnode = "body"\nforce = [{force}, 0.0, 0.0]\n'
-            '[[steps]]\nkind = "static"\nname = "s"\n')
+    """Three 850 m chains at 120 degrees, from anchors 800 m out on a 200 m deep seabed, to a
+    body node held in z only, pushed along x by ``force``."""
+    angles = np.radians([0.0, 120.0, 240.0])
+    anchors = {f"a{i}": (800 * math.cos(a), 800 * math.sin(a), -200.0)
+               for i, a in enumerate(angles)}
+    return scene(materials={"chain": {"EA": 7.5e8, "mass": 110.0, "diameter": 0.17}},
+                 nodes={"body": (0.0, 0.0, -20.0), **anchors},
+                 supports=('body = ["z"]', *anchors),
+                 cables=[cable(f"L{i}", (a, "body"), "chain", 850.0, ne)
+                         for i, a in enumerate(anchors)],
+                 extra=section("water", density=1025.0, depth=200.0) + "[seabed]\n"
+                 + load("wind", [force, 0.0, 0.0], node="body"), steps=static_step("s"))
 
 
 def test_a_spread_mooring_pushed_far_matches_moorpy():

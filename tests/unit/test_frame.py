@@ -15,7 +15,7 @@ import xarray as xr
 import catdae
 from catdae.case.frame import gravity_rotation, local_axes, rotate_back, to_gravity_frame
 
-from scene_toml import cable_scene, load, static_step, support_motion
+from scene_toml import cable_scene, damper, load, static_step, step, support_motion
 
 EZ = np.array([0.0, 0.0, 1.0])
 
@@ -122,38 +122,15 @@ def test_a_case_already_in_the_frame_is_returned_as_it_is():
     assert R is None and local is case
 
 
-STAY_DAMPER = """
-{gravity}
-[materials.strand]
-EA = 2.55e9
-mass = 100.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [200.0, 0.0, 0.0]
-base = {base}
-[supports]
-A = "pinned"
-B = "pinned"
-base = "pinned"
-[[cables]]
-name = "stay"
-ends = ["A", "B"]
-material = "strand"
-length = 199.62
-elements = 20
-[[dampers]]
-name = "d"
-ends = ["stay.1", "base"]
-coefficient = 1.0e5
-[[steps]]
-kind = "static"
-name = "st"
-[[steps]]
-kind = "modal"
-name = "modes"
-modes = 4
-sweep = {{ field = "dampers.d.coefficient", values = [1.0e5, 3.0e5] }}
-"""
+def stay_damper(gravity, base) -> str:
+    """A 200 m stay with a damper from its first mesh node to the ground node ``base``, and a
+    modal step swept over the damper's coefficient."""
+    return cable_scene(B=(200.0, 0.0, 0.0), L0=199.62, EA=2.55e9, mass=100.0, elements=20,
+                       gravity=gravity, material="strand", cable="stay", nodes={"base": base},
+                       supports=("A", "B", "base"),
+                       extra=damper("d", ["stay.1", "base"], 1.0e5),
+                       steps=static_step() + step("modal", "modes", modes=4, sweep={
+                           "field": "dampers.d.coefficient", "values": [1.0e5, 3.0e5]}))
 
 
 def test_a_swept_modal_step_under_a_gravity_vector_is_the_upright_one_rotated():
@@ -162,9 +139,8 @@ def test_a_swept_modal_step_under_a_gravity_vector_is_the_upright_one_rotated():
     turned upright by the rotation (x, y, z) -> (x, -z, y), which takes -y to -z, must give
     the same frequencies and damping ratios, and the same shapes with the axes relabelled,
     each scaled to a largest component of 1."""
-    tilted = catdae.run(STAY_DAMPER.format(gravity="gravity = [0.0, -9.81, 0.0]",
-                                           base="[10.0, 0.0, 1.0]"))["modes"].ds
-    upright = catdae.run(STAY_DAMPER.format(gravity="", base="[10.0, -1.0, 0.0]"))["modes"].ds
+    tilted = catdae.run(stay_damper((0.0, -9.81, 0.0), (10.0, 0.0, 1.0)))["modes"].ds
+    upright = catdae.run(stay_damper(None, (10.0, -1.0, 0.0)))["modes"].ds
     for name in ("frequency", "undamped_frequency", "damping_ratio", "undamped_mode"):
         np.testing.assert_allclose(tilted[name].values, upright[name].values, rtol=1e-8)
     perm = [0, 2, 1]  # the tilted frame's (x, y, z) are the upright (x, z, -y)
