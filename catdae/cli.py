@@ -18,6 +18,7 @@ from importlib.resources import files
 from pathlib import Path
 
 from catdae._version import __version__
+from catdae.case.overrides import max_order_arg
 from catdae.case.schema import MASS_MODEL_NAMES
 from catdae.errors import CaseError, CatdaeError, InternalError, OutputError, ResultsError
 from catdae.interrupts import signals_as_interrupts
@@ -34,17 +35,6 @@ DEFAULT_CASE = "example1_free_vibration.toml"
 def default_case_path() -> Path:
     """The bundled default case (the paper's example 1)."""
     return Path(str(files("catdae") / "data" / DEFAULT_CASE))
-
-
-def max_order_arg(text: str) -> int | str:
-    """``--max-order`` of ``catdae run`` and ``catdae study``: "auto" or an integer (its range
-    is judged with the case's own field)."""
-    if text == "auto":
-        return text
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}") from None
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -5,6 +5,7 @@ mesh."""
 
 from __future__ import annotations
 
+import argparse
 import math
 import numbers
 from dataclasses import replace
@@ -102,3 +103,14 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
     if problems:
         raise CaseError(self.path, problems)
     return case
+
+
+def max_order_arg(text: str) -> int | str:
+    """``--max-order`` of ``catdae run`` and ``catdae study``: "auto" or an integer (its range
+    is judged with the case's own field)."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}") from None

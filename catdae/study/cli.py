@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from catdae.cli import max_order_arg as _order
+from catdae.case.overrides import max_order_arg as _order
 from catdae.errors import CaseError, OutputError
 from catdae.study.core import CHOICES, StudyError
 from catdae.study.report import summary, write_study
