@@ -14,6 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 SAG_LAMBDA2 = 1.0  # elements with λ² above this take a chord change by sag (the note's rule)
+SAG_AMPLIFICATION = 1.0  # elements whose midpoint moves sideways by more than this times a
+#                          change of their chord: a taut but light, stiff element whose sag
+#                          breathes with its stretch (docs/theory.md §7.1, §18.5)
 SNAP_SHARE = 0.05  # a sudden change counts where the force it sends (m c Δv of a velocity
 #                    jump, the force of an item added or removed) reaches this share of the
 #                    largest tension at the start: a record's round-off steps or a small load
@@ -75,22 +78,48 @@ def unbalance(model, state, X: np.ndarray, t0: float,
     return float(norms[k]), k
 
 
+def sag_amplification(model, state, X: np.ndarray) -> np.ndarray:
+    """How far each element's midpoint moves sideways per metre of change of its chord,
+    (n_elem,): |(I - ĉĉᵀ) B(L0/2) ĉ| from the interpolation N(s) = [I - B(s), B(s)] (a stretch
+    moves end j by +ĉ/2 and end i by -ĉ/2; the straight line's share, ĉ/2 - ĉ/2 at the middle,
+    is along ĉ). About P⊥ EA / (8 T²) for an element of transverse load P⊥ at tension T: the
+    sag w L²/(8T) shrinks as the stretch raises T. 0 for a slack element (its λ² says it)."""
+    el = model.elements
+    c = model.chords(X)
+    n = np.linalg.norm(c, axis=1)
+    u = c / np.where(n > 0, n, 1.0)[:, None]
+    b = el.interpolation(state, 0.5 * el.L0[:, None])[:, 0, :, 3:]  # (n, 3, 3)
+    d = np.einsum("eij,ej->ei", b, u)
+    d -= np.einsum("ei,ei->e", d, u)[:, None] * u
+    return np.linalg.norm(d, axis=1)
+
+
 def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
                 h0: np.ndarray | None = None) -> str:
     """Why the transient ``step`` starting from positions ``X`` and velocities ``V`` (n_nodes, 3)
     at t0 can snap ("" if it cannot): a start out of balance (an item added or removed, a mass
     let go) or a support velocity jump, whose force (the largest out-of-balance force on a
     node; m c Δv of the jump's wave, c = sqrt(EA/m)) reaches ``SNAP_SHARE`` of the largest
-    tension, while elements take a chord change by sag (λ² > 1 at the start)."""
+    tension, while elements take a chord change by sag (λ² > 1 at the start) or their sag
+    breathes with their stretch (``sag_amplification`` > 1: a taut, light, stiff line, whose
+    catenary mass then makes the unresolved axial ringing pump itself up at BDF order 2)."""
     model.set_time(t0)
     state = model.element_state(X, h0)
     lam2 = model.element_lambda2(state, X)
     sag = lam2 > SAG_LAMBDA2
-    if not sag.any():
+    amp = np.where(sag, 0.0, sag_amplification(model, state, X))
+    breathes = amp > SAG_AMPLIFICATION
+    if not (sag.any() or breathes.any()):
         return ""
     worst = float(lam2.max())
-    where = (f"{int(sag.sum())} of {lam2.size} elements take a chord change by sag (λ² up to "
-             + ("inf, slack" if not np.isfinite(worst) else f"{worst:.3g}") + ", > 1)")
+    where = " and ".join(
+        ([f"{int(sag.sum())} of {lam2.size} elements take a chord change by sag (λ² up to "
+          + ("inf, slack" if not np.isfinite(worst) else f"{worst:.3g}") + ", > 1)"]
+         if sag.any() else [])
+        + ([f"{int(breathes.sum())} of {lam2.size} elements move their middle sideways by up "
+            f"to {float(amp.max()):.3g} times a change of their chord (> 1: their sag breathes "
+            "with the stretch, an inertia the catenary mass gives a fast axial motion too)"]
+           if breathes.any() else []))
     t_max = float(model.tensions(state).max(initial=0.0))
     force, node = unbalance(model, state, X, t0, V)
     if force >= SNAP_SHARE * t_max:
