@@ -22,7 +22,12 @@ import numpy as np
 from numba import njit
 
 from catdae.element.catenary import CONVERGED, NOT_CONVERGED, SLACK, solve_one
-from catdae.element.catenary_batch import carry_tension
+from catdae.element.catenary_batch import (
+    carry_tension,
+    end_tension_batch,
+    energy_batch,
+    partial_batch,
+)
 from catdae.element.lagrange import kinetic_one, lagrange_one
 from catdae.element.mass import dynamic_forces, mass_one
 from catdae.element.mass_gradient import gradient_fade
@@ -183,3 +188,90 @@ def residual_pass(y, yp, fidx, fixed, xp, vp, ap, conn, edofs, X, V, A, l0, ea, 
         res[2 * k + 1] = force[d] + m_diag[d] * A[d] + v_diag[d] * V[d] - p_nodal[d]
     carried[0] = True
     return True
+
+
+@njit(cache=True)
+def output_batch(k0, k1, Y, YP, XP, VP, AP, P, p_timed, fidx, fixed, conn, edofs, l0, ea, w,
+                 ptr, ls, lf, load_total, wl0, h, use_h, gs, gw, mq, cq, pmptr, pms, pmm,
+                 want_m, use_m, want_c, use_c, want_dm, scale, alpha, beta, m_diag, v_diag,
+                 energy_only, lin_kin, me, ce, xi, wi, i_elem, i_slot, i_s, i_force, node_force,
+                 Xo, Vo, Ao, To, Ro, Eo):
+    """The outputs k0 <= k < k1 of a transient step from their states Y[k], YP[k] (IDA's y and
+    y' interleaved) at support values XP, VP, AP[k] and nodal loads P[k] (P[0] when not
+    ``p_timed``): positions, velocities and accelerations (Xo, Vo, Ao, full dofs), end
+    tensions To (n_elem, 2), support reactions Ro (the fixed dofs' M A + C V + g + F - P) and
+    the energies Eo (kinetic, strain, potential of gravity and constant loads). Each output is
+    one ``residual_pass`` (as an output's ``observe`` does, ``energy_only`` the elements off the
+    supports) warm-started from the tensions of the one before (``h``, updated), then the
+    energies of ``record.potential`` (``i_*``: the loads inside elements, at slot ``i_slot`` of
+    element ``i_elem``, arc length in ``i_s`` (n_elem, q)). ``lin_kin``: the kinetic energy of
+    a constant (linear) element mass ``me``. Returns k1, or the first output whose elements
+    cannot be solved (nothing written for it)."""
+    ne = conn.shape[0]
+    nd = m_diag.shape[0]
+    X = np.zeros(nd)
+    V = np.zeros(nd)
+    A = np.zeros(nd)
+    hw = np.zeros((ne, 3))
+    fflat = np.zeros((ne, 6))
+    kmat = np.zeros((ne, 3, 3))
+    its = np.zeros(ne, np.int64)
+    stat = np.zeros(ne, np.int64)
+    force = np.zeros(nd)
+    res = np.zeros(Y.shape[1])
+    carried = np.zeros(1, np.bool_)
+    kin = np.zeros(ne)
+    en = np.zeros((ne, 2))
+    xs = np.zeros((ne, i_s.shape[1], 3))
+    gs6 = np.zeros((ne, i_s.shape[1], 6))
+    for k in range(k0, k1):
+        carried[0] = False
+        pk = P[k] if p_timed else P[0]
+        if not residual_pass(Y[k], YP[k], fidx, fixed, XP[k], VP[k], AP[k], conn, edofs, X, V, A,
+                             l0, ea, w, ptr, ls, lf, load_total, wl0, h, hw, use_h, 1e-12, 100,
+                             gs, gw, mq, cq, pmptr, pms, pmm, want_m, use_m, want_c, use_c,
+                             want_dm, scale, alpha, beta, m_diag, v_diag, pk, fflat, kmat, its,
+                             stat, me, ce, force, res, energy_only, carried, kin):
+            return k
+        for e in range(ne):
+            for a in range(3):
+                h[e, a] = hw[e, a]
+        use_h = True
+        kinetic = 0.0
+        for d in range(nd):
+            Xo[k, d] = X[d]
+            Vo[k, d] = V[d]
+            Ao[k, d] = A[d]
+            kinetic += 0.5 * m_diag[d] * V[d] * V[d]
+        for j in range(fixed.shape[0]):
+            d = fixed[j]
+            Ro[k, j] = force[d] + m_diag[d] * A[d] + v_diag[d] * V[d] - pk[d]
+        end_tension_batch(hw, load_total, w, l0, To[k])
+        if want_m:
+            for e in range(ne):
+                kinetic += kin[e]
+        elif lin_kin:
+            for e in range(ne):
+                acc = 0.0
+                for r in range(6):
+                    for c in range(6):
+                        acc += V[edofs[e, r]] * me[e, r, c] * V[edofs[e, c]]
+                kinetic += 0.5 * acc
+        energy_batch(hw, l0, ea, w, ptr, ls, lf, xi, wi, en)
+        strain = 0.0
+        gravity = 0.0
+        for e in range(ne):
+            strain += en[e, 0]
+            gravity += en[e, 1] + wl0[e] * X[3 * conn[e, 0] + 2]
+        if i_elem.shape[0] > 0:
+            partial_batch(hw, l0, ea, w, ptr, ls, lf, i_s, xs, gs6, False)
+            for m in range(i_elem.shape[0]):
+                e = i_elem[m]
+                for a in range(3):
+                    gravity -= i_force[m, a] * (X[3 * conn[e, 0] + a] + xs[e, i_slot[m], a])
+        for d in range(nd):
+            gravity -= node_force[d] * X[d]
+        Eo[k, 0] = kinetic
+        Eo[k, 1] = strain
+        Eo[k, 2] = gravity
+    return k1

@@ -178,6 +178,24 @@ class TensionEnvelope:
             tension += prob.axial.tension()[:, None]
         return tension
 
+    def update_many(self, times: np.ndarray, tension: np.ndarray) -> None:
+        """Take the tensions (n, n_elements, 2) of the outputs at ``times`` (n,) into the
+        envelope (a batch of deferred outputs: the same extremes as one ``update`` each; a tie
+        keeps the earlier time)."""
+        if times.size == 0:
+            return
+        for i, pick in ((0, np.argmax), (1, np.argmin)):
+            k = pick(tension, axis=0)  # (n_elements, 2): the first extreme of the batch
+            v = np.take_along_axis(tension, k[None], axis=0)[0]
+            t = times[k]
+            ext, when = self._ext[i], self._ext_time[i]
+            better = (v > ext) if i == 0 else (v < ext)
+            better |= np.isnan(ext) | ((v == ext) & (t < when))
+            if self.n_updates == 0:
+                better[:] = True
+            ext[better], when[better] = v[better], t[better]
+        self.n_updates += times.size
+
     def update(self, t: float, y: np.ndarray | None = None,
                tension: np.ndarray | None = None) -> None:
         """Take the state y at t (or its tensions, when known) into the envelope: the

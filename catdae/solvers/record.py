@@ -9,6 +9,7 @@ import numpy as np
 
 from catdae.model.assembly import Model
 from catdae.model.fluid import plausibility_note
+from catdae.solvers.deferred import DeferredOutputs, can_defer
 from catdae.solvers.energy_check import gain_note
 from catdae.solvers.envelope import TensionEnvelope
 from catdae.solvers.fluid_work import FluidWork
@@ -38,14 +39,31 @@ class OutputRecord:
         self.n_valid = 0
         self.attrs: dict = {}
         self.envelope = TensionEnvelope(prob)  # every accepted step and every output
+        # outputs computed in batches where no Python is needed at each (catdae.solvers.deferred)
+        self.deferred = DeferredOutputs(prob, times.size) if can_defer(prob) else None
+        self.n_computed = 0  # outputs 0 .. n_computed - 1 are in the arrays
 
     def record(self, k: int, t: float, y: np.ndarray, yp: np.ndarray) -> None:
+        """Output k at t from IDA's y, y' (kept for a batch, or computed now)."""
+        d = self.deferred
+        if d is not None:
+            if d.count and k != d.first + d.count:  # outputs again after a lost order race
+                d.compute(self)
+            if d.keep(k, t, y, yp):
+                d.compute(self)
+            return
         X, V, A, T, R, E = self.prob.observe(t, y, yp)
         self.X[k], self.V[k], self.A[k] = X.reshape(-1, 3), V.reshape(-1, 3), A.reshape(-1, 3)
         self.T[k], self.R[k], self.E[k] = T, R, E
         self.envelope.update(t, tension=T)
         if self.work is not None:  # observe's residual pass left the fluid's M_a A - f
             self.W[k] = self.work.at(t, y, yp, power=-float(self.prob.model.fluid.out @ V))
+        self.n_computed = k + 1
+
+    def flush(self) -> None:
+        """Compute the outputs kept for a batch (SolverError where one cannot be)."""
+        if self.deferred is not None:
+            self.deferred.compute(self)
 
     def upto(self, n_valid: int, attrs: dict) -> OutputRecord:
         """This record with its first ``n_valid`` outputs valid and ``attrs`` set."""

@@ -208,6 +208,13 @@ class _Run:
         }
 
     def snapshot(self, n_valid: int) -> OutputRecord:
+        """The record of the outputs reached so far, those kept for a batch computed first."""
+        try:
+            self.outputs.flush()
+        except SolverError as exc:  # after the loop stopped: what was computed is kept
+            if self.status == "completed":
+                self.status = str(exc)
+        n_valid = min(n_valid, self.outputs.n_computed)
         return self.outputs.upto(n_valid, self.attributes(n_valid))
 
     # ------------------------------------------------------------------ integration
@@ -218,6 +225,8 @@ class _Run:
         self.k_done = 0
         try:
             self._loop(writer, bar)
+            if self.status == "completed":  # the outputs kept for a batch (SolverError)
+                self.outputs.flush()
         except KeyboardInterrupt as exc:  # goes on after the partial record is attached below
             self.status = f"interrupted at {self._reached()}"
             interrupt = exc
@@ -321,6 +330,7 @@ class _Run:
         return hook, solver
 
     def _write_snapshot(self, writer) -> None:  # of the run so far
+        self.outputs.flush()  # an output that cannot be computed stops the run here
         writer.write_increment(self.step.name, self.snapshot(self.k_done), self._reached())
         self.hook.written()
 
