@@ -223,9 +223,10 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress,
             return _modal_step(step, model, state).assign_attrs(equilibrium=moving,
                                                                 note=moving)
         return _modal_step(step, model, state)
-    from catdae.solvers.transient import run_transient  # the only module that imports sksundae
+    # the only modules that import sksundae; auto's catenary mass run again lumped if it gained
+    from catdae.solvers.auto_rerun import run_transient_auto
 
-    ds = as_dataset(run_transient(step, model, state, writer, progress))
+    ds = as_dataset(run_transient_auto(step, model, state, writer, progress))
     if model.case.seabed is not None:  # touchdown and length on the seabed over time (§17)
         from catdae.model.seabed import SeabedContact
         from catdae.output.seabed import add_seabed_history

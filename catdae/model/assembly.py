@@ -84,6 +84,7 @@ class Model(MassMatrices):
         transient can snap, catdae.model.snap)."""
         self.case = case
         self.mesh = mesh
+        self.absent = frozenset(absent)
         self.loading = build_loading(case, mesh, absent)
         ends = (free_hanging_ends(case, mesh, self.loading.node_mass) if mass_model == "auto"
                 else [])

@@ -112,7 +112,7 @@ def note(model: Model, prob, rec: OutputRecord | None = None, n_valid: int = 0) 
     model, and (given the record and its ``n_valid`` outputs) an energy balance that does not
     close (catdae/solvers/energy_check.py)."""
     advice = [_mass_note(model, prob), gain_note(model, prob, rec, n_valid),
-              _slack_note(model, rec, n_valid), plausibility_note(model.case)]
+              slack_note(model, rec, n_valid), plausibility_note(model.case)]
     return "; ".join(a for a in advice if a)
 
 
@@ -120,7 +120,7 @@ SLACK, SNAP = 0.1, 1.5  # an element end that fell below SLACK of its start tens
 # above SNAP times it during a step went nearly slack and snapped taut
 
 
-def _slack_note(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
+def slack_note(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
     """A catenary (consistent or blended) mass and an element end whose tension envelope fell
     below SLACK of its tension at the start and rose above SNAP times it, or went into
     compression below -SLACK of it: the line went nearly slack and snapped taut, which only a

@@ -40,6 +40,9 @@ class StepHook:
         self.race = run.order_choice if (run.order_choice is not None
                                          and run.order_choice.measuring) else None
         self.dt_out = run.dt_out
+        # a callable of the envelope that returns why the step must stop ("" to go on), or None
+        self.watch = getattr(run, "watch", None)
+        self.stop_reason = ""
         self.tout = self.tstop = math.nan
         # a snapshot of the run so far is due every write_every s of wall time (None: no
         # writer), at the wall time ``due``; between two outputs the hook asks IDA to return
@@ -104,6 +107,10 @@ class StepHook:
         run = self.run
         run.n_steps += 1
         self.envelope.update(t, y)
+        if self.watch is not None and self.t_flag is None:
+            self.stop_reason = self.watch(self.envelope, t)
+            if self.stop_reason:
+                self.t_flag = t  # IDA returns here, and the driver stops the step
         if self.work is not None:
             self.work.advance(t, y, yp)
         small = t - self.t_prev <= STALL_STEP * max(abs(t), self.dt_out)

@@ -93,14 +93,14 @@ def choose_solver(problem: TransientProblem, requested: str) -> str:
     return "sparse"
 
 
-def run_transient(step, model: Model, state, writer, progress) -> OutputRecord:
+def run_transient(step, model: Model, state, writer, progress, watch=None) -> OutputRecord:
     """Integrate one transient step from ``state`` (positions, velocities, tensions): the
     output record (arrays and attributes). On failure or interrupt the record of what was
     computed is the exception's ``partial``; ``writer.write_increment`` gets snapshots."""
     # the progress reporter runs from the step's start: the set-up may compile the kernels
     bar = reporter(progress, step.name, float(state.t), float(state.t) + float(step.duration))
     try:
-        run = _Run(step, model, state)
+        run = _Run(step, model, state, watch)
         rec = run.integrate(writer, bar)
     finally:
         bar.close()
@@ -117,8 +117,8 @@ class _Run:
     start) in ``__init__``, then ``integrate`` (the loop), ``attributes`` (what the results
     say of the run)."""
 
-    def __init__(self, step, model: Model, state):
-        self.wall0 = _time.perf_counter()
+    def __init__(self, step, model: Model, state, watch=None):
+        self.wall0, self.watch = _time.perf_counter(), watch  # watch: StepHook may stop it
         self.step, self.model = step, model
         self.prob = prob = TransientProblem(model, step, state.X, state.h)
         self.t0 = float(state.t)  # one clock for the whole case: a transient continues the time
@@ -207,8 +207,7 @@ class _Run:
             "axial_damping": "none" if prob.axial is None else prob.axial.describe(),
         }
 
-    def snapshot(self, n_valid: int) -> OutputRecord:
-        """The record of the outputs reached so far, those kept for a batch computed first."""
+    def snapshot(self, n_valid: int) -> OutputRecord:  # the outputs kept for a batch first
         try:
             self.outputs.flush()
         except SolverError as exc:  # after the loop stopped: what was computed is kept
@@ -344,9 +343,10 @@ class _Run:
             self._write_snapshot(writer)
             return solver, t, False
         new_order = self.hook.take_order()
-        if new_order is None:
-            self.status = (f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
-                           f"{self.prob.n_rejected} trial states rejected)")
+        if new_order is None or self.hook.stop_reason:  # stuck, or stopped by the watch
+            self.status = self.hook.stop_reason or (
+                f"step size collapsed at t = {t:.6g} s (IDA could not advance; "
+                f"{self.prob.n_rejected} trial states rejected)")
             return None, t, False
         solver, t, fresh = self._change_order(solver, new_order, t, res.y, res.yp)
         self.hook.reset(t)  # IDA goes on from t: nothing asked of it, nothing seen after t
