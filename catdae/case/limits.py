@@ -26,6 +26,9 @@ MIN_TIME = 1e-9  # s: shortest step duration, output interval or ramp duration
 MAX_FREQUENCY = 1e9  # Hz, of a sine or cosine time function
 MAX_COORDINATE = 1e7  # m, of a node (10 000 km); far beyond it, squared lengths overflow
 MAX_DIAMETER = 1e7  # m, of a line: its area and volume would overflow far beyond it
+MAX_LINE_MASS = 1e9  # kg/m and N/m (mass, weight, damping per metre): a solid steel bar 400 m
+#                      across; far beyond, the totals (times lengths up to 1e7 m) overflow
+MAX_POINT_MASS = 1e15  # kg, of one point mass (a million supertankers)
 TABLE_ROOTS_ENV = "CATDAE_TABLE_ROOTS"  # more folders table files may be read from
 
 
@@ -97,7 +100,8 @@ def confined(name: str, base_dir: Path) -> Path:
 def output_count(duration: float, output_interval: float) -> float:
     """Output times of a transient step (as transient.run_transient lays them out), as a float
     so that absurd requests are counted without overflow."""
-    return math.floor(duration / output_interval + 1e-9) + 2.0
+    q = duration / output_interval  # inf for a duration near 1e308: counted, not floored
+    return (math.floor(q + 1e-9) if math.isfinite(q) else math.inf) + 2.0
 
 
 def transient_bytes(n_out: float, n_nodes: int, n_elements: int) -> float:

@@ -16,6 +16,8 @@ from catdae.case.limits import (
     MAX_DIAMETER,
     MAX_ELEMENTS_PER_CABLE,
     MAX_FREQUENCY,
+    MAX_LINE_MASS,
+    MAX_POINT_MASS,
     MIN_TIME,
 )
 
@@ -67,9 +69,9 @@ class TopSchema(BaseModel):
 class MaterialSchema(BaseModel):
     model_config = STRICT
     EA: Pos
-    mass: NonNeg
-    weight: NonNeg | None = None
-    damping: NonNeg = 0.0
+    mass: Annotated[float, Field(ge=0, le=MAX_LINE_MASS)]
+    weight: Annotated[float, Field(ge=0, le=MAX_LINE_MASS)] | None = None
+    damping: Annotated[float, Field(ge=0, le=MAX_LINE_MASS)] = 0.0
     thermal_expansion: float = 0.0
     # fluid properties of the line (docs/case-format.md, "Water and air")
     diameter: Annotated[float, Field(gt=0, le=MAX_DIAMETER)] | None = None
@@ -94,7 +96,7 @@ class CableSchema(BaseModel):
 class PointMassSchema(BaseModel):
     model_config = STRICT
     name: Name
-    mass: Pos
+    mass: Annotated[float, Field(gt=0, le=MAX_POINT_MASS)]
     node: Name | None = None
     cable: Name | None = None
     s: NonNeg | None = None
