@@ -18,6 +18,7 @@ from catdae.case.limits import (
     MAX_FREQUENCY,
     MAX_LINE_MASS,
     MAX_POINT_MASS,
+    MAX_VECTOR,
     MIN_TIME,
 )
 
@@ -32,7 +33,9 @@ Rtol = Annotated[float, Field(gt=0, le=0.1)]
 NonNeg = Annotated[float, Field(ge=0)]
 Time = Annotated[float, Field(ge=MIN_TIME)]  # s: shorter is degenerate (0/0 in a ramp)
 Frequency = Annotated[float, Field(gt=0, le=MAX_FREQUENCY)]
-Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+Force = Annotated[float, Field(gt=0, le=MAX_VECTOR)]  # N, a tension target
+Vec3 = Annotated[list[Annotated[float, Field(ge=-MAX_VECTOR, le=MAX_VECTOR)]],
+                 Field(min_length=3, max_length=3)]
 Name = Annotated[str, Field(min_length=1)]
 # settings a command line may override too (``OverridesSchema``): one type for both
 Elements = Annotated[int, Field(ge=1, le=MAX_ELEMENTS_PER_CABLE)]
@@ -188,11 +191,11 @@ class FormSchema(BaseModel):
     """``form = { ... }`` of a cable: exactly one target (the builder checks which)."""
 
     model_config = STRICT
-    pretension: Pos | None = None
-    horizontal_tension: Pos | None = None
-    tension: Pos | None = None
+    pretension: Force | None = None
+    horizontal_tension: Force | None = None
+    tension: Force | None = None
     at: Name | None = None
-    sag: Pos | None = None
+    sag: Annotated[float, Field(gt=0, le=MAX_COORDINATE)] | None = None
 
 
 FORM_TARGETS = ("pretension", "horizontal_tension", "tension", "sag")
