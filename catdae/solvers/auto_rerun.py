@@ -11,12 +11,13 @@ are read: an element whose tension rose from a sag-dominated state (λ² > 1 at 
 the tension where its λ² is 1 (λ² ∝ T⁻³ at a given load and length, so T ≥ T₀ (λ²₀)^⅓ =
 (w⊥ l)^⅔ EA^⅓: its sag was pulled out and it took the chord change by stretch) and to at least
 twice its start (an element just above λ² = 1 crosses it at a small rise), watched in the
-tension envelope at every step, which stops the run there; and, at the end, an element that
-went nearly slack (or into compression) and snapped taut (``record.slack_note``: a taut line
-heaved into a snap, +47 % on the peak with the blended mass) or an energy gain
-(``energy_check.energy_gain``). The step is then run again from the same start with the lumped
-mass, which carries the waves, and its ``mass_model_choice`` says why. A step whose mass was set
-by hand is never run twice."""
+tension envelope, which stops the run there; an element that went nearly slack (or into
+compression) and snapped taut (``record.slack_note``: a taut line heaved into a snap, +47 % on
+the peak with the blended mass), watched too; and, at the end, an energy gain
+(``energy_check.energy_gain``). The envelope is looked at every ``WATCH_EVERY`` steps (it keeps
+the extremes in between): a few µs per look. The step is then run again from the same start
+with the lumped mass, which carries the waves, and its ``mass_model_choice`` says why. A step
+whose mass was set by hand is never run twice."""
 
 from __future__ import annotations
 
@@ -25,18 +26,19 @@ import numpy as np
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.solvers.energy_check import energy_gain
-from catdae.solvers.record import slack_note
+from catdae.solvers.record import SLACK, SNAP, slack_note
 from catdae.solvers.transient import run_transient
 
 PULLED = "pulled taut"  # the status of a first run that the watch stopped
 RISE = 2.0  # a tension that rose less than this many times its start is no snap (an element
 #             just above λ² = 1 at the start passes λ² = 1 at a 1.2 times higher tension)
+WATCH_EVERY = 8  # steps between two looks at the envelope (it keeps the extremes between)
 
 
 def run_transient_auto(step, model: Model, state, writer, progress):
     """``run_transient``, and again with the lumped mass where ``auto`` kept a catenary mass
     and the run pulled sagging elements taut or gained energy (module docstring). The first run
-    is stopped as soon as an element is pulled taut (its envelope is watched at every step).
+    is stopped as soon as an element is pulled taut or snaps after slack (the envelope watched).
     ``state`` is left as the run that is kept leaves it."""
     mm = model.mass_model
     if not (mm.setting == "auto" and mm.catenary):
@@ -48,11 +50,21 @@ def run_transient_auto(step, model: Model, state, writer, progress):
     t0 = model.tensions(start_state).min(axis=1)
     taut_at = np.maximum(t0 * np.cbrt(lam2), RISE * t0)  # where λ² = 1, and risen RISE times
     watched = np.flatnonzero((lam2 > 1.0) & np.isfinite(taut_at))
-    watch = None
-    if watched.size:
-        def watch(envelope, t: float) -> str:
-            over = envelope.t_max[watched].max(axis=1) >= taut_at[watched]
-            return f"{PULLED} at t = {t:.6g} s" if over.any() else ""
+    start_t = model.tensions(start_state)  # (n_elem, 2), as the record's first output
+    loaded = start_t > 0.0
+    calls = [0]
+
+    def watch(envelope, t: float) -> str:
+        """Why the run must stop at t ("" to go on); judged every WATCH_EVERY steps."""
+        calls[0] += 1
+        if calls[0] % WATCH_EVERY:
+            return ""
+        lo, hi = envelope.t_min, envelope.t_max
+        if watched.size and (hi[watched].max(axis=1) >= taut_at[watched]).any():
+            return f"{PULLED} at t = {t:.6g} s"
+        snapped = loaded & (((lo < SLACK * start_t) & (hi > SNAP * start_t))
+                            | (lo < -SLACK * start_t))
+        return f"{PULLED} after slack at t = {t:.6g} s" if snapped.any() else ""
     try:
         rec = run_transient(step, model, state, writer, progress, watch)
     except SolverError as exc:
@@ -83,8 +95,9 @@ def _why(model: Model, rec, lam2: np.ndarray, taut_at: np.ndarray) -> str:
         return (f"a first run with the {mm} mass pulled sagging elements taut (element "
                 f"{model.mesh.element_names[e]}: λ² {lam2[e]:.3g} at the start, tension "
                 f"{t_max[e]:.4g} N at t = {when:.6g} s, past {taut_at[e]:.4g} N, where λ² is 1 "
-                f"and at least {RISE:g} times its start): the line snaps taut in the step, and "
-                "the catenary mass does not carry the axial waves of a snap")
+                f"and at least {RISE:g} times its start): a sagging line pulled taut takes "
+                "chord changes by stretch, as a snap does, whose axial waves the catenary mass "
+                "does not carry")
     slack = slack_note(model, rec, rec.n_valid)
     if slack:  # a taut line that went slack (or into compression) and snapped taut
         return f"in a first run with the {mm} mass, {slack.split(': a snap after slack')[0]}"

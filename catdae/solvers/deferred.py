@@ -61,6 +61,31 @@ class DeferredOutputs:
         self.i_force = np.ascontiguousarray(ld.internal_force, float).reshape(-1, 3)
         self.node_force = np.ascontiguousarray(ld.node_force, float).reshape(-1)
         self.lin_kin = bool(prob._use_m and not prob._want_m)
+        self.load_kernel()
+
+    def _batch(self, n: int, h, use_h: bool, Xo, Vo, Ao, To, Ro, Eo) -> int:
+        """``output_batch`` on the first n rows kept."""
+        prob, m = self.prob, self.prob.model
+        el = m.elements
+        pmptr, pms, pmm = prob._pm
+        return output_batch(
+            0, n, self.Y, self.YP, self.XP, self.VP, self.AP, self.P, self.p_timed, prob._fidx,
+            prob._fixed, prob._conn, prob._edofs, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf,
+            el._load_total, prob._wl0, h, use_h, m.gauss_s, m.gauss_w, m.mesh.m, m.mesh.c, pmptr,
+            pms, pmm, prob._want_m, prob._use_m, prob._want_c, prob._use_c, prob._want_dm,
+            prob._scale, prob.alpha, prob.beta, prob.m_diag, prob._v_diag,
+            prob._energy_only_output, self.lin_kin, prob._me, prob._ce, _GAUSS8[0], _GAUSS8[1],
+            self.i_elem, self.i_slot, self.i_s, self.i_force, self.node_force, Xo, Vo, Ao, To,
+            Ro, Eo)
+
+    def load_kernel(self) -> None:
+        """Load (or compile) the batch kernel now, with an empty batch: at the step's set-up, as
+        the residual's kernels are, not in the middle of the run, where a signal that arrives
+        while numba loads it can be lost in a destructor (a SIGHUP ignored, the run completed)."""
+        ne, nd = self.prob.model.mesh.n_elements, self.prob.n_dof
+        out = (np.empty((1, nd)), np.empty((1, nd)), np.empty((1, nd)), np.empty((1, ne, 2)),
+               np.empty((1, self.prob._fixed.size)), np.empty((1, 3)))
+        self._batch(0, np.zeros((ne, 3)), False, *out)
 
     def keep(self, k: int, t: float, y, yp) -> bool:
         """Keep output k's state (copied: IDA reuses its arrays); True when the batch is full.
@@ -87,22 +112,12 @@ class DeferredOutputs:
         if n == 0:
             return
         prob, m = self.prob, self.prob.model
-        el = m.elements
         ne, nd = m.mesh.n_elements, prob.n_dof
         Xo, Vo, Ao = np.empty((n, nd)), np.empty((n, nd)), np.empty((n, nd))
         To, Ro, Eo = np.empty((n, ne, 2)), np.empty((n, prob._fixed.size)), np.empty((n, 3))
         use_h = self.h is not None
         h = self.h.copy() if use_h else np.zeros((ne, 3))  # updated by the batch
-        pmptr, pms, pmm = prob._pm
-        done = output_batch(
-            0, n, self.Y, self.YP, self.XP, self.VP, self.AP, self.P, self.p_timed, prob._fidx,
-            prob._fixed, prob._conn, prob._edofs, el.L0, el.EA, el.w, el._ptr, el._ls, el._lf,
-            el._load_total, prob._wl0, h, use_h, m.gauss_s, m.gauss_w, m.mesh.m, m.mesh.c, pmptr,
-            pms, pmm, prob._want_m, prob._use_m, prob._want_c, prob._use_c, prob._want_dm,
-            prob._scale, prob.alpha, prob.beta, prob.m_diag, prob._v_diag,
-            prob._energy_only_output, self.lin_kin, prob._me, prob._ce, _GAUSS8[0], _GAUSS8[1],
-            self.i_elem, self.i_slot, self.i_s, self.i_force, self.node_force, Xo, Vo, Ao, To,
-            Ro, Eo)
+        done = self._batch(n, h, use_h, Xo, Vo, Ao, To, Ro, Eo)
         self.h = h if done > 0 else self.h
         k0 = self.first
         sl = slice(k0, k0 + done)
