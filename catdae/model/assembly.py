@@ -217,6 +217,12 @@ class Model(MassMatrices):
             f = f + self.connectors.force(X)  # (bincount of no element gives ints)
         return f
 
+    def unit_chords(self, X: np.ndarray) -> np.ndarray:
+        """The elements' chords as unit vectors, (n_elem, 3) (zero for a chord of zero length)."""
+        c = self.chords(X)
+        n = np.linalg.norm(c, axis=1)
+        return c / np.where(n > 0, n, 1.0)[:, None]
+
     def element_lambda2(self, state: ElementState, X: np.ndarray) -> np.ndarray:
         """Irvine's λ² of each element from its stiffness along the chord, (n_elem,).
 
@@ -224,9 +230,7 @@ class Model(MassMatrices):
         (EA / (L0 k_cc) - 1) with k_cc = ĉᵀ K ĉ. λ² ≪ 1: the element takes a change of chord by
         stretch (a bar); λ² ≫ 1: by sag (inf for a slack element, K = 0).
         """
-        c = self.chords(X)
-        n = np.linalg.norm(c, axis=1)
-        u = c / np.where(n > 0, n, 1.0)[:, None]
+        u = self.unit_chords(X)
         kcc = np.einsum("ei,eij,ej->e", u, state.K, u)
         with np.errstate(divide="ignore"):
             ratio = np.where(kcc > 0, self.mesh.EA / (self.mesh.L0 * np.maximum(kcc, 1e-300)),

@@ -85,9 +85,7 @@ def sag_amplification(model, state, X: np.ndarray) -> np.ndarray:
     is along ĉ). About P⊥ EA / (8 T²) for an element of transverse load P⊥ at tension T: the
     sag w L²/(8T) shrinks as the stretch raises T. 0 for a slack element (its λ² says it)."""
     el = model.elements
-    c = model.chords(X)
-    n = np.linalg.norm(c, axis=1)
-    u = c / np.where(n > 0, n, 1.0)[:, None]
+    u = model.unit_chords(X)
     b = el.interpolation(state, 0.5 * el.L0[:, None])[:, 0, :, 3:]  # (n, 3, 3)
     d = np.einsum("eij,ej->ei", b, u)
     d -= np.einsum("ei,ei->e", d, u)[:, None] * u

@@ -12,7 +12,7 @@ the tension where its λ² is 1 (λ² ∝ T⁻³ at a given load and length, so 
 (w⊥ l)^⅔ EA^⅓: its sag was pulled out and it took the chord change by stretch) and to at least
 twice its start (an element just above λ² = 1 crosses it at a small rise), watched in the
 tension envelope, which stops the run there; an element that went nearly slack (or into
-compression) and snapped taut (``record.slack_note``: a taut line heaved into a snap, +47 % on
+compression) and snapped taut (``record.slack_where``: a taut line heaved into a snap, +47 % on
 the peak with the blended mass), watched too; and, at the end, an energy gain
 (``energy_check.energy_gain``). The envelope is looked at every ``WATCH_EVERY`` steps (it keeps
 the extremes in between): a few µs per look. The step is then run again from the same start
@@ -26,7 +26,7 @@ import numpy as np
 from catdae.errors import SolverError
 from catdae.model.assembly import Model
 from catdae.solvers.energy_check import energy_gain
-from catdae.solvers.record import SLACK, SNAP, slack_note
+from catdae.solvers.record import slack_snapped, slack_where
 from catdae.solvers.transient import run_transient
 
 PULLED = "pulled taut"  # the status of a first run that the watch stopped
@@ -47,11 +47,10 @@ def run_transient_auto(step, model: Model, state, writer, progress):
              state.t)
     start_state = model.element_state(state.X, state.h)
     lam2 = model.element_lambda2(start_state, state.X)
-    t0 = model.tensions(start_state).min(axis=1)
+    start_t = model.tensions(start_state)  # (n_elem, 2), as the record's first output
+    t0 = start_t.min(axis=1)
     taut_at = np.maximum(t0 * np.cbrt(lam2), RISE * t0)  # where λ² = 1, and risen RISE times
     watched = np.flatnonzero((lam2 > 1.0) & np.isfinite(taut_at))
-    start_t = model.tensions(start_state)  # (n_elem, 2), as the record's first output
-    loaded = start_t > 0.0
     calls = [0]
 
     def watch(envelope, t: float) -> str:
@@ -62,9 +61,8 @@ def run_transient_auto(step, model: Model, state, writer, progress):
         lo, hi = envelope.t_min, envelope.t_max
         if watched.size and (hi[watched].max(axis=1) >= taut_at[watched]).any():
             return f"{PULLED} at t = {t:.6g} s"
-        snapped = loaded & (((lo < SLACK * start_t) & (hi > SNAP * start_t))
-                            | (lo < -SLACK * start_t))
-        return f"{PULLED} after slack at t = {t:.6g} s" if snapped.any() else ""
+        snapped = slack_snapped(lo, hi, start_t).any()
+        return f"{PULLED} after slack at t = {t:.6g} s" if snapped else ""
     try:
         rec = run_transient(step, model, state, writer, progress, watch)
     except SolverError as exc:
@@ -98,9 +96,9 @@ def _why(model: Model, rec, lam2: np.ndarray, taut_at: np.ndarray) -> str:
                 f"and at least {RISE:g} times its start): a sagging line pulled taut takes "
                 "chord changes by stretch, as a snap does, whose axial waves the catenary mass "
                 "does not carry")
-    slack = slack_note(model, rec, rec.n_valid)
+    slack = slack_where(model, rec, rec.n_valid)
     if slack:  # a taut line that went slack (or into compression) and snapped taut
-        return f"in a first run with the {mm} mass, {slack.split(': a snap after slack')[0]}"
+        return f"in a first run with the {mm} mass, {slack}"
     found = energy_gain(model, rec.prob, rec, rec.n_valid)
     if found is None:
         return ""

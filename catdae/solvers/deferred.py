@@ -16,7 +16,7 @@ from catdae.element.residual_kernel import output_batch
 from catdae.errors import SolverError
 
 BATCH = 256  # outputs kept before they are computed (memory: 2 × BATCH states)
-_GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs (as potential)
+GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs (also potential's)
 
 
 def can_defer(prob) -> bool:
@@ -74,7 +74,7 @@ class DeferredOutputs:
             el._load_total, prob._wl0, h, use_h, m.gauss_s, m.gauss_w, m.mesh.m, m.mesh.c, pmptr,
             pms, pmm, prob._want_m, prob._use_m, prob._want_c, prob._use_c, prob._want_dm,
             prob._scale, prob.alpha, prob.beta, prob.m_diag, prob._v_diag,
-            prob._energy_only_output, self.lin_kin, prob._me, prob._ce, _GAUSS8[0], _GAUSS8[1],
+            prob._energy_only_output, self.lin_kin, prob._me, prob._ce, GAUSS8[0], GAUSS8[1],
             self.i_elem, self.i_slot, self.i_s, self.i_force, self.node_force, Xo, Vo, Ao, To,
             Ro, Eo)
 

@@ -9,12 +9,10 @@ import numpy as np
 
 from catdae.model.assembly import Model
 from catdae.model.fluid import plausibility_note
-from catdae.solvers.deferred import DeferredOutputs, can_defer
+from catdae.solvers.deferred import GAUSS8, DeferredOutputs, can_defer
 from catdae.solvers.energy_check import gain_note
 from catdae.solvers.envelope import TensionEnvelope
 from catdae.solvers.fluid_work import FluidWork
-
-_GAUSS8 = np.polynomial.legendre.leggauss(8)  # energy integrals at the outputs
 
 
 class OutputRecord:
@@ -88,7 +86,7 @@ def potential(model: Model, X: np.ndarray, h: np.ndarray, t: float):
     time function have no potential: their work changes the total energy)."""
     mesh = model.mesh
     el = model.elements
-    per_element = el.energies(h, *_GAUSS8)  # strain (exact), ∫ w (z - z_i) ds
+    per_element = el.energies(h, *GAUSS8)  # strain (exact), ∫ w (z - z_i) ds
     strain = float(per_element[:, 0].sum())
     gravity = float(per_element[:, 1].sum() + mesh.w @ (mesh.L0 * X[mesh.conn[:, 0], 2]))
     # loads inside elements (point-mass weights, constant loads) and at nodes
@@ -112,7 +110,7 @@ def note(model: Model, prob, rec: OutputRecord | None = None, n_valid: int = 0) 
     model, and (given the record and its ``n_valid`` outputs) an energy balance that does not
     close (catdae/solvers/energy_check.py)."""
     advice = [_mass_note(model, prob), gain_note(model, prob, rec, n_valid),
-              slack_note(model, rec, n_valid), plausibility_note(model.case)]
+              _slack_note(model, rec, n_valid), plausibility_note(model.case)]
     return "; ".join(a for a in advice if a)
 
 
@@ -120,30 +118,42 @@ SLACK, SNAP = 0.1, 1.5  # an element end that fell below SLACK of its start tens
 # above SNAP times it during a step went nearly slack and snapped taut
 
 
-def slack_note(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
-    """A catenary (consistent or blended) mass and an element end whose tension envelope fell
-    below SLACK of its tension at the start and rose above SNAP times it, or went into
-    compression below -SLACK of it: the line went nearly slack and snapped taut, which only a
-    mass that carries axial waves carries in full
-    (docs/accuracy.md; an independent tester's smooth but violent support motion: +33 % on
-    the peak tension with the blended mass, not converging with rtol or the mesh)."""
-    if rec is None or n_valid < 1 or not model.mass_model.catenary:
+def slack_snapped(t_min: np.ndarray, t_max: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """Element ends (a mask like ``start``) loaded at the start whose tension envelope fell
+    below SLACK of it and rose above SNAP times it, or went into compression below -SLACK of it
+    (a cable cannot be: a slack element the catenary mass mis-carries)."""
+    return (start > 0.0) & (((t_min < SLACK * start) & (t_max > SNAP * start))
+                            | (t_min < -SLACK * start))
+
+
+def slack_where(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
+    """Which element ends went nearly slack and snapped taut (``slack_snapped``): the element
+    that fell furthest, its tensions and when ("" if none)."""
+    if rec is None or n_valid < 1:
         return ""
     env = rec.envelope
     start = rec.T[0]
-    loaded = start > 0.0
-    # or it was compressed (a cable cannot be: a slack element the catenary mass mis-carries)
-    fell = loaded & (((env.t_min < SLACK * start) & (env.t_max > SNAP * start))
-                     | (env.t_min < -SLACK * start))
+    fell = slack_snapped(env.t_min, env.t_max, start)
     if not fell.any():
         return ""
+    loaded = start > 0.0
     e, k = np.argwhere(fell)[np.argmin((env.t_min / np.where(loaded, start, 1.0))[fell])]
     return (f"element {model.mesh.element_names[e]!r} went nearly slack and snapped taut "
             f"(tension {env.t_min[e, k]:.4g} N at t = {env.time_min[e, k]:.6g} s, "
-            f"{start[e, k]:.4g} N at the start, up to {env.t_max[e, k]:.4g} N): a snap "
-            f"after slack is carried in full only by a mass that carries axial waves, and "
-            f"mass_model {model.mass_model.name!r} does not: compare the peak tension with "
-            "mass_model = \"lumped\" (docs/accuracy.md)")
+            f"{start[e, k]:.4g} N at the start, up to {env.t_max[e, k]:.4g} N)")
+
+
+def _slack_note(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
+    """A catenary (consistent or blended) mass and an element end that went nearly slack and
+    snapped taut (``slack_where``), which only a mass that carries axial waves carries in full
+    (docs/accuracy.md; an independent tester's smooth but violent support motion: +33 % on
+    the peak tension with the blended mass, not converging with rtol or the mesh)."""
+    where = slack_where(model, rec, n_valid) if model.mass_model.catenary else ""
+    if not where:
+        return ""
+    return (f"{where}: a snap after slack is carried in full only by a mass that carries "
+            f"axial waves, and mass_model {model.mass_model.name!r} does not: compare the peak "
+            "tension with mass_model = \"lumped\" (docs/accuracy.md)")
 
 
 def _mass_note(model: Model, prob) -> str:

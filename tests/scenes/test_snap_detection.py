@@ -23,7 +23,7 @@ import catdae
 from catdae.case import case_from_dict
 
 from repo_paths import CASES  # noqa: E402
-from scene_toml import cable_scene, point_mass, transient_step
+from scene_toml import cable_scene, point_mass, static_step, support_motion, transient_step
 
 CLUMP = 2.0e5  # N
 
@@ -160,44 +160,12 @@ def test_a_smooth_drive_that_pulls_the_sagging_line_taut_is_run_again_lumped():
     assert kept.attrs["mass_model"] == "blended", kept.attrs["mass_model_choice"]
 
 
-HEAVED = """
-title = "taut line heaved into slack and back"
-[materials.rope]
-EA = 1.0e6
-mass = 1.0
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [10.0, 0.0, 0.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "rope"
-ends = ["A", "B"]
-material = "rope"
-length = 9.99
-elements = 20
-[[support_motions]]
-node = "B"
-[support_motions.x]
-kind = "trapezoid"
-amplitude = -0.15
-rise = 0.2
-hold = 0.1
-fall = 0.2
-start = 0.1
-smooth = true
-[[steps]]
-kind = "static"
-name = "initial"
-[[steps]]
-kind = "transient"
-name = "heave"
-duration = 1.5
-output_interval = 0.005
-rtol = 1e-5
-atol = 1e-6
-"""
+HEAVED = cable_scene(
+    title="taut line heaved into slack and back", B=(10.0, 0.0, 0.0), L0=9.99, EA=1.0e6,
+    mass=1.0, elements=20, material="rope", cable="rope",
+    extra=support_motion("B", x={"kind": "trapezoid", "amplitude": -0.15, "rise": 0.2,
+                                 "hold": 0.1, "fall": 0.2, "start": 0.1, "smooth": True}),
+    steps=static_step("initial") + transient_step("heave", 1.5, 0.005, rtol=1e-5, atol=1e-6))
 
 
 def test_a_taut_rope_heaved_into_slack_and_back_is_stopped_and_run_again_lumped():
