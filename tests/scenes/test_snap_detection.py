@@ -154,6 +154,7 @@ def test_a_smooth_drive_that_pulls_the_sagging_line_taut_is_run_again_lumped():
     ref = catdae.run(case_from_dict(tomllib.loads(fine)))["fast"].ds
     peak, peak_ref = float(ds.tension_max.max()), float(ref.tension_max.max())
     assert abs(peak / peak_ref - 1) < 0.15, (peak, peak_ref)
+    assert "energy balance" not in ds.attrs["note"], ds.attrs["note"]  # as in the heaved rope
     # a twentieth of the drive: the tension stays near its start, the blended run is kept
     small = SHAKEN.replace("{ay}", "0.04").replace("{az}", "-0.025").replace("{oz}", "0.025")
     kept = catdae.run(case_from_dict(tomllib.loads(small)))["fast"].ds
@@ -185,6 +186,10 @@ def test_a_taut_rope_heaved_into_slack_and_back_is_stopped_and_run_again_lumped(
     assert discarded < 20_000, discarded  # stopped near the snap, not at the end
     peak = float(ds.tension_max.max())
     assert abs(peak / 13.76e3 - 1) < 0.05, peak
+    # the lumped run follows its equations (its peak is the tester's): the support's work
+    # between outputs 5 ms apart, which the outputs cannot see, is no energy gain (a 15 J
+    # "gain" was noted before; none with outputs ten times closer)
+    assert "energy balance" not in ds.attrs["note"], ds.attrs["note"]
 
 
 BOB, LINE_EA, LINE_MASS, LINE_L, THETA0 = 10.0, 1.0e7, 0.01, 10.0, math.radians(60.0)
