@@ -117,6 +117,8 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
     e1 = horiz / np.linalg.norm(horiz)  # along the span
     e3 = np.array([0.0, 0.0, 1.0])
     e2 = np.cross(e3, e1)  # normal to the cable plane
+    t_chord = chord / np.linalg.norm(chord)  # along the chord, and normal to it in the plane
+    n_chord = np.cross(e2, t_chord)
     s_along = mesh.s_node[order]
     s_mirror = s_along[0] + s_along[-1] - s_along
 
@@ -131,11 +133,13 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
         a3 = u @ e3
         in_plane = float(a1 @ a1 + a3 @ a3) >= float(out @ out)
         plane.append("in-plane" if in_plane else "out-of-plane")
-        # mirror about midspan: along-span component changes sign, the others keep theirs
+        # mirror about the chord's middle: the component along the chord changes sign, the
+        # one normal to it (in the plane) keeps its sign (an inclined stay's modes too)
         if in_plane:
-            m1, m3 = mirrored(a1), mirrored(a3)
-            s_part = np.sum((a3 + m3) ** 2) + np.sum((a1 - m1) ** 2)
-            a_part = np.sum((a3 - m3) ** 2) + np.sum((a1 + m1) ** 2)
+            ac, an = u @ t_chord, u @ n_chord
+            mc, mn = mirrored(ac), mirrored(an)
+            s_part = np.sum((an + mn) ** 2) + np.sum((ac - mc) ** 2)
+            a_part = np.sum((an - mn) ** 2) + np.sum((ac + mc) ** 2)
         else:
             mo = mirrored(out)
             s_part = np.sum((out + mo) ** 2)
