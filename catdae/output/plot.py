@@ -32,6 +32,7 @@ from catdae.output.environment import axis_names, drawing_frame, still_levels
 from catdae.output.plot_envelopes import mark_peaks, reactions
 from catdae.output.plot_parts import draw_connectors, label, legend
 from catdae.output.plot_parts import subplots as _subplots
+from catdae.output.reading import ratio_text
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
@@ -305,8 +306,12 @@ def tension(data, times=None) -> Figure:
 
 def modes(data, n: int = 6) -> Figure:
     """The first n mode shapes: elevation (x-z components against x) and plan (y), each
-    titled with its frequency."""
+    titled with its frequency. A damped modal step draws its damped modes (in their order,
+    sorted by |s|): the real part of ``complex_shape``, titled with ``frequency`` (damped),
+    ``damping_ratio`` and the ``damped_`` labels; its ``shape`` and labels are the undamped
+    modes', in their own order (docs/case-format.md)."""
     ds = _ds(data, "modes")
+    damped = "complex_shape" in ds
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise PlotError(f"n: expected the number of modes to draw, an integer >= 1, found {n!r}")
     n = min(int(n), ds.mode.size)
@@ -314,14 +319,18 @@ def modes(data, n: int = 6) -> Figure:
     paths = _paths(ds)
     x_of = ds.reference_position.sel(axis="x") if "reference_position" in ds else None
     for k, ax in enumerate(axes[:, 0]):
-        sh = ds["shape"].isel(mode=k)
+        sh = (ds["complex_shape"].isel(mode=k).sel(part="real") if damped
+              else ds["shape"].isel(mode=k))
         mode = int(ds.mode.values[k])
         for cab, nodes in paths.items():
             x = x_of.sel(node=nodes).values if x_of is not None else ds.s.sel(node=nodes).values
             for a, style in (("y", "--"), ("z", "-")):
                 ax.plot(x, sh.sel(node=nodes, axis=a).values, style, marker=".",
                         label=f"{cab} {a}", gid=f"{mode}|{cab}|{a}")
-        extra = ", ".join(str(ds[v].values[k]) for v in ("plane", "symmetry") if v in ds)
+        names = ("damped_plane", "damped_symmetry") if damped else ("plane", "symmetry")
+        extra = ", ".join(str(ds[v].values[k]) for v in names if v in ds)
+        if damped:
+            extra += f", damping ratio {ratio_text(ds.damping_ratio.values[k], '.3g')}"
         ax.set_title(f"mode {mode}: {float(ds.frequency.values[k]):.4g} "
                      f"{ds.frequency.attrs.get('units', '')}" + (f" ({extra})" if extra else ""),
                      fontsize="medium")

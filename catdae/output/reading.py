@@ -124,3 +124,10 @@ def read_results_file(path: str | os.PathLike, steps: bool = True) -> xr.DataTre
             raise ResultsError(f"cannot read {path}: group {name[:60]!r}: {why} (not a "
                                "catdae results file, or a half-written one)")
     return tree
+
+
+def ratio_text(zeta, fmt: str = ".4g") -> str:
+    """A damping ratio as printed: the round-off of an undamped mode (|ζ| < 1e-12, e.g.
+    -5.6e-15, which would read as an instability) as 0."""
+    zeta = float(zeta)
+    return "0" if abs(zeta) < 1e-12 else format(zeta, fmt)

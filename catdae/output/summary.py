@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae.output.end_peaks import at_end
-from catdae.output.reading import step_values
+from catdae.output.reading import ratio_text, step_values
 
 
 def summary(tree) -> str:
@@ -124,7 +124,7 @@ def _mode_lines(name: str, ds) -> list[str]:
         line = (f"    mode {int(mode)}: {float(ds.frequency.values[k]):.6g} Hz"
                 + (f", {labels}" if labels else ""))
         if damped:
-            line += f", damping ratio {float(ds.damping_ratio.values[k]):.4g}"
+            line += f", damping ratio {ratio_text(ds.damping_ratio.values[k])}"
             like = int(ds.undamped_mode.values[k]) if "undamped_mode" in ds else k + 1
             if like >= 1:  # the undamped mode it is most like, not the k-th (sorted by |s|)
                 f_u = float(ds.undamped_frequency.sel(mode=like))

@@ -666,8 +666,8 @@ def test_an_inclined_stays_in_plane_modes_are_labelled_by_its_chord():
     text = cable_scene(B=B, L0=l / (1 + T / 8.0e7), EA=8.0e7, mass=m, elements=40,
                        steps=static_step() + modal_step(8, mass_model="consistent"))
     ds = catdae.run(catdae.load_case(text))["modes"].ds
-    inplane = [(float(f), str(s)) for f, p, s in
-               zip(ds.frequency.values, ds.plane.values, ds.symmetry.values) if p == "in-plane"]
+    labels = zip(ds.frequency.values, ds.plane.values, ds.symmetry.values, strict=True)
+    inplane = [(float(f), str(s)) for f, p, s in labels if p == "in-plane"]
     assert len(inplane) >= 3, inplane
     f1 = math.sqrt(T * (1 + T / 8.0e7) / m) / (2 * l)
     for n, (f, sym) in enumerate(inplane, start=1):

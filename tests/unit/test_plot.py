@@ -12,6 +12,7 @@ from catdae.cli import main
 from catdae.output import plot
 
 from repo_paths import CASES  # noqa: E402
+from scene_toml import cable_scene, damper, modal_step, static_step  # noqa: E402
 
 EX1 = CASES / "example1_free_vibration.toml"
 THREE = CASES / "three_cables_shared_node.toml"
@@ -141,3 +142,34 @@ def test_catdae_plot_writes_png_files(ex1, tmp_path, capsys):
     assert (tmp_path / "figs" / "release-history.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert main(["plot", str(out), "-o", str(tmp_path / "x"), "--node", "nowhere"]) == 2
     assert "no node 'nowhere'" in capsys.readouterr().err
+
+
+def test_damped_modes_are_drawn_as_the_damped_modes_they_are_titled_with():
+    """A taut level cable (100 m, 1e5 N) with a damper across the plane (along y) at 6 m from
+    A, at about its optimal coefficient: the out-of-plane mode 1 is damped and its frequency
+    moves above the in-plane one, so sorted by |s| the damped modes are not in the undamped
+    order (an independent tester's figure titled the in-plane frequency over the out-of-plane
+    shape). Each panel draws the real part of its damped mode's complex shape, its title gives
+    that mode's damped frequency and damping ratio, and the drawn shape moves mostly in the
+    plane its title names."""
+    text = cable_scene(B=(100.0, 0.0, 0.0), L0=99.02, EA=1.0e7, mass=1.0, elements=50,
+                       nodes={"G": (6.0, 2.0, 0.0)}, supports=("G", "A", "B"),
+                       extra=damper("d", ["c.3", "G"], 3000.0),
+                       steps=static_step() + modal_step(6))
+    ds = catdae.run(catdae.load_case(text))["modes"].to_dataset()
+    assert "complex_shape" in ds
+    assert list(ds.undamped_mode.values[:2]) != [1, 2]  # the case the figure got wrong
+    fig = plot.modes(ds, n=4)
+    for k, ax in enumerate(fig.axes):
+        mode = int(ds.mode.values[k])
+        real = ds.complex_shape.sel(mode=mode, part="real")
+        (ly,) = _lines(ax, f"{mode}|c|y")
+        (lz,) = _lines(ax, f"{mode}|c|z")
+        path = plot._paths(ds)["c"]  # the nodes along the cable, A to B
+        np.testing.assert_array_equal(ly.get_ydata(), real.sel(node=path, axis="y"))
+        title = ax.get_title()
+        assert f"{float(ds.frequency.sel(mode=mode)):.4g} Hz" in title
+        zeta = float(ds.damping_ratio.sel(mode=mode))
+        assert (f"damping ratio {zeta:.3g}" if abs(zeta) > 1e-12 else "damping ratio 0") in title
+        across = np.sum(ly.get_ydata() ** 2) > np.sum(lz.get_ydata() ** 2)
+        assert ("out-of-plane" in title) == across, (title, mode)
