@@ -50,8 +50,12 @@ class _State:
         self.t = 0.0
 
 
-def as_case(case_or_path: Case | str | os.PathLike) -> Case:
-    return case_or_path if isinstance(case_or_path, Case) else load_case(case_or_path)
+def as_case(case_or_path: Case | str | os.PathLike, elements: int | None = None) -> Case:
+    """A Case as given, or read from a path or text (``elements``: judged on that mesh)."""
+    if isinstance(case_or_path, Case):
+        return case_or_path if elements is None else case_or_path.with_overrides(
+            elements=elements)
+    return load_case(case_or_path, elements=elements)
 
 
 OVERRIDES = ("rtol", "atol", "elements", "mass_model", "max_order")  # Case.with_overrides
@@ -73,8 +77,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         raise TypeError(f"catdae.run() got an unexpected keyword argument {unknown[0]!r}; it "
                         f"takes output, progress, on_group and the overrides "
                         f"{', '.join(OVERRIDES)}")
-    case = as_case(case_or_path)
     ov = {k: v for k, v in overrides.items() if v is not None}
+    case = as_case(case_or_path, ov.pop("elements", None))
     if ov:
         case = case.with_overrides(**ov)
     # solved where gravity is -z (catdae.case.frame); vector results are rotated back

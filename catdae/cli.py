@@ -144,9 +144,8 @@ def _check(args) -> int:
     from catdae.analysis import check_case
     from catdae.case import load_case
 
-    case = load_case(Path(args.case))  # the command line always names a file
-    if args.elements is not None:  # as catdae run --elements would mesh it
-        case = case.with_overrides(elements=args.elements)
+    # the command line always names a file; meshed as catdae run --elements would mesh it
+    case = load_case(Path(args.case), elements=args.elements)
     mesh = check_case(case)
     say(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
         f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
@@ -159,7 +158,7 @@ def _run(args) -> int:
     from catdae.output.files import check_output
 
     path = Path(args.case) if args.case else default_case_path()
-    case = load_case(path)
+    case = load_case(path, elements=args.elements)  # judged on the mesh asked for
     out = Path(args.output) if args.output is not None else Path(f"{path.stem}.nc")
     try:
         check_output(args.output if args.output is not None else out, case)
@@ -180,7 +179,7 @@ def _run(args) -> int:
     try:
         with announce_compiling():  # whenever numba compiles, the first time is announced
             tree = run(case, output=out, progress=args.progress, rtol=args.rtol,
-                       atol=args.atol, elements=args.elements, mass_model=args.mass_model,
+                       atol=args.atol, mass_model=args.mass_model,
                        max_order=args.max_order, on_group=finished)
     except CaseError:
         raise  # an invalid override (exit 2), reported by main

@@ -16,8 +16,13 @@ from catdae.case.model import Case
 from catdae.errors import CaseError
 
 
-def load_case(path_or_text: str | os.PathLike, *, name: str | None = None) -> Case:
+def load_case(path_or_text: str | os.PathLike, *, name: str | None = None,
+              elements: int | None = None) -> Case:
     """Read and validate a case.
+
+    ``elements``: the case as ``Case.with_overrides(elements=...)`` gives it, its counts and
+    sizes judged against the limits for that mesh, not for the file's (``catdae run
+    --elements``: fewer elements than the file's may fit where the file's do not).
 
     ``path_or_text`` is a path (a ``PathLike``, or a one-line string ending in ``.toml`` or naming
     an existing file) or the TOML text itself. ``name`` defaults to the file's stem, or ``"case"``
@@ -58,19 +63,23 @@ def load_case(path_or_text: str | os.PathLike, *, name: str | None = None) -> Ca
     if name is None:
         name = Path(path).stem if path else "case"
     base_dir = Path(path).parent if path else Path.cwd()
-    return case_from_dict(data, path=path, text=text, name=name, base_dir=base_dir)
+    case = case_from_dict(data, path=path, text=text, name=name, base_dir=base_dir,
+                          judge_size=elements is None)
+    return case if elements is None else case.with_overrides(elements=elements)
 
 
 def case_from_dict(data: Mapping[str, Any], *, path: str | None = None, text: str = "",
-                   name: str = "case", base_dir: str | os.PathLike | None = None) -> Case:
+                   name: str = "case", base_dir: str | os.PathLike | None = None,
+                   judge_size: bool = True) -> Case:
     """Validate an already-parsed case (the dict ``tomllib`` returns) and build the Case.
 
-    ``base_dir`` resolves ``table`` files (default: the current directory).
+    ``base_dir`` resolves ``table`` files (default: the current directory). ``judge_size``
+    False leaves the limits on counts and sizes to the caller's ``with_overrides(elements=)``.
     """
     if not isinstance(data, Mapping):
         raise CaseError(path, [("", f"expected a table of keys, found {found_text(data)}")])
     builder = Builder(path, Path(base_dir) if base_dir is not None else Path.cwd())
-    return builder.build(dict(data), text=text, name=name)
+    return builder.build(dict(data), text=text, name=name, judge_size=judge_size)
 
 
 def _looks_like_path(obj: Any) -> bool:

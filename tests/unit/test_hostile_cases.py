@@ -254,6 +254,24 @@ def test_the_size_limit_is_judged_again_after_an_elements_override(tmp_path, cap
             tmp_path, capsys, subprocess_check=False, run_args=["--elements", "200"])
 
 
+def test_fewer_elements_asked_for_are_judged_not_the_files(tmp_path, capsys):
+    """A file whose 200 elements would store too much, run with --elements 4 (an independent
+    tester was refused on the file's mesh, with the file's figures in the message): check
+    passes and says 4 elements; the file alone is refused."""
+    from catdae.case import load_case
+    from catdae.cli import main
+
+    steps = static_step("st") + transient_step("dyn", 100.0, 1e-3, rtol=1e-6, atol=1e-8)
+    f = tmp_path / "case.toml"
+    f.write_text(scene(steps=steps, elements=200))
+    assert main(["check", str(f)]) == 2
+    assert "201 nodes and 200 elements" in capsys.readouterr().err
+    assert main(["check", str(f), "--elements", "4"]) == 0
+    assert "4 elements, 5 nodes" in capsys.readouterr().out
+    case = load_case(f, elements=4)
+    assert [c.elements for c in case.cables] == [4]
+
+
 def test_a_modal_step_that_needs_a_dense_solve_too_large_is_refused(tmp_path, capsys):
     invalid(scene(steps=static_step("st") + modal_step(10**9), elements=10000), "steps[1].modes",
             "modal step 'modes': 29997 modes of 29997 free degrees of freedom need", tmp_path,
