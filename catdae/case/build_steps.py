@@ -121,6 +121,7 @@ class StepsPass:
     def steps(self, raw: list[dict]) -> list[Step]:
         out = []
         names: dict[str, int] = {}
+        self.faulty_static: set[str] = set()  # static steps not built: their problems are said
         # what is present before each step, and why: the name -> (present, reason) of add/remove
         presence = {r: (r not in self.inactive, "active = false" if r in self.inactive else
                         "active from the start") for r in self.removable}
@@ -159,6 +160,8 @@ class StepsPass:
                              "'+', '@' or inner spaces (no '/'; netCDF group names), found "
                              f"{shorten(nm)}")
             names.setdefault(nm, i)
+            if kind == "static":
+                self.faulty_static.add(nm)  # until it is built (below)
             if v is None:
                 continue
             self.add_remove(v, where, nm, presence)
@@ -189,6 +192,7 @@ class StepsPass:
             temperature = self.step_temperature(v, where)
             sweep = self.sweep(v.sweep, where, self.connector_items)
             if complete and temperature is not False and sweep is not False:
+                self.faulty_static.discard(nm)
                 out.append(Step(kind=kind, name=nm, remove=tuple(v.remove),
                                 add=tuple(v.add), temperature_change=temperature,
                                 sweep=sweep, **extra))
@@ -236,6 +240,8 @@ class StepsPass:
             return None
         static = [s.name for s in earlier if s.kind == "static"]
         if name in static:
+            return name
+        if name in self.faulty_static:  # a static step with problems of its own, said there
             return name
         kinds = {s.name: s.kind for s in earlier}
         after = {r.get("name") for r in later if isinstance(r, dict)}

@@ -330,3 +330,13 @@ def test_a_static_state_stretched_far_beyond_a_cable_is_noted(tmp_path):
         ds = valid(text.replace("{f}", repr(force)), tmp_path)
         step = next(iter(ds.children.values())).to_dataset()
         assert ("far beyond what a cable carries" in step.attrs.get("note", "")) == noted
+
+
+def test_a_static_step_with_a_mistake_is_no_unknown_jump_reference(tmp_path, capsys):
+    """One mistake in the static step that a transient's jump_reference names: that mistake is
+    the only problem said (an independent tester got a second, false one: "unknown static step
+    'bare'", sending the user to the wrong field)."""
+    steps = ('[[steps]]\nkind = "static"\nname = "bare"\nload_steps = 0\n'
+             + transient_step("shed", 0.1, 0.05, rtol=1e-4, atol=1e-6,
+                              extra='jump_reference = "bare"\n'))
+    invalid(scene(steps=steps), "steps[0].load_steps", "expected", tmp_path, capsys)
