@@ -57,10 +57,19 @@ def unbalance(model, state, X: np.ndarray, t0: float,
               V: np.ndarray | None = None) -> tuple[float, int]:
     """(the largest out-of-balance force on a free node at t0, N; that node's index): what a
     step that starts out of equilibrium (a load or mass added or removed, a mass let go)
-    releases at once. The forces are those of the transient's residual at t0 with no
-    acceleration: the elements, the loads, the water and air (buoyancy, drag on the velocities
-    ``V``, the waves at t0) and the seabed's contact springs, so that a line resting on the
-    seabed or held up by its buoyancy in the static state is in balance here too."""
+    releases at once (``unbalance_forces``)."""
+    norms = np.linalg.norm(unbalance_forces(model, state, X, t0, V), axis=1)
+    k = int(np.argmax(norms))
+    return float(norms[k]), k
+
+
+def unbalance_forces(model, state, X: np.ndarray, t0: float,
+                     V: np.ndarray | None = None) -> np.ndarray:
+    """The residual force on each node at t0 with no acceleration, (n_nodes, 3) N (0 at the
+    supports, which take theirs as reactions): the elements, the loads, the water and air
+    (buoyancy, drag on the velocities ``V``, the waves at t0) and the seabed's contact springs,
+    so that a line resting on the seabed or held up by its buoyancy in the static state is in
+    balance here too. The node is pushed along minus it."""
     r = model.internal_force(state, X) - model.nodal_load(t0)
     v = np.zeros(r.size) if V is None else np.asarray(V, float).reshape(-1)
     if model.fluid is not None:  # M_a A - f_fluid at A = 0: -f_fluid
@@ -73,9 +82,25 @@ def unbalance(model, state, X: np.ndarray, t0: float,
             r = r - contact.forces(np.reshape(X, (-1, 3)), v.reshape(-1, 3)).ravel()
     r = r.reshape(-1, 3)
     r[model.fixed_mask] = 0.0  # the supports take theirs as reactions
-    norms = np.linalg.norm(r, axis=1)
-    k = int(np.argmax(norms))
-    return float(norms[k]), k
+    return r
+
+
+def release_slackens(model, state, X: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Elements whose tension a start out of balance can take to zero, (n_elem,) bool. The net
+    force -r_k on a node k, let go at once, changes the tension of each element at k by its
+    part along the element, drop = -r_k · ĉ (ĉ from k towards the element's other end) at the
+    new balance, and the undamped axial ringing about it overshoots by as much again: the
+    tension falls to about T - 2 drop, which is below zero when the drop is more than half the
+    tension (a bob held 50° aside on a light line and let go: 152.6 N falls towards 63 N and
+    rings through zero). Whatever the element's λ² (a weightless line has none) it then goes
+    slack and snaps taut again."""
+    conn = model.mesh.conn
+    t_end = model.tensions(state)  # (n_elem, 2): at end i, at end j
+    c = np.reshape(X, (-1, 3))[conn[:, 1]] - np.reshape(X, (-1, 3))[conn[:, 0]]
+    c /= np.maximum(np.linalg.norm(c, axis=1), 1e-300)[:, None]
+    drop_i = np.einsum("ej,ej->e", -r[conn[:, 0]], c)  # end i: towards j is +ĉ
+    drop_j = np.einsum("ej,ej->e", -r[conn[:, 1]], -c)
+    return (t_end[:, 0] < 2.0 * drop_i) | (t_end[:, 1] < 2.0 * drop_j)
 
 
 def sag_amplification(model, state, X: np.ndarray) -> np.ndarray:
@@ -100,14 +125,24 @@ def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
     node; m c Δv of the jump's wave, c = sqrt(EA/m)) reaches ``SNAP_SHARE`` of the largest
     tension, while elements take a chord change by sag (λ² > 1 at the start) or their sag
     breathes with their stretch (``sag_amplification`` > 1: a taut, light, stiff line, whose
-    catenary mass then makes the unresolved axial ringing pump itself up at BDF order 2)."""
+    catenary mass then makes the unresolved axial ringing pump itself up at BDF order 2), or,
+    for a start out of balance, while it takes elements through zero tension
+    (``release_slackens``)."""
     model.set_time(t0)
     state = model.element_state(X, h0)
     lam2 = model.element_lambda2(state, X)
     sag = lam2 > SAG_LAMBDA2
     amp = np.where(sag, 0.0, sag_amplification(model, state, X))
     breathes = amp > SAG_AMPLIFICATION
-    if not (sag.any() or breathes.any()):
+    t_max = float(model.tensions(state).max(initial=0.0))
+    r = unbalance_forces(model, state, X, t0, V)
+    norms = np.linalg.norm(r, axis=1)
+    node = int(np.argmax(norms))
+    force = float(norms[node])
+    released = force >= SNAP_SHARE * t_max
+    slackens = (release_slackens(model, state, X, r) & ~sag & ~breathes if released
+                else np.zeros(lam2.size, bool))
+    if not (sag.any() or breathes.any() or slackens.any()):
         return ""
     worst = float(lam2.max())
     where = " and ".join(
@@ -117,10 +152,11 @@ def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
         + ([f"{int(breathes.sum())} of {lam2.size} elements move their middle sideways by up "
             f"to {float(amp.max()):.3g} times a change of their chord (> 1: their sag breathes "
             "with the stretch, an inertia the catenary mass gives a fast axial motion too)"]
-           if breathes.any() else []))
-    t_max = float(model.tensions(state).max(initial=0.0))
-    force, node = unbalance(model, state, X, t0, V)
-    if force >= SNAP_SHARE * t_max:
+           if breathes.any() else [])
+        + ([f"{int(slackens.sum())} of {lam2.size} elements lose more than half their tension "
+            "to it at the new balance (their axial ringing about it goes through zero: they "
+            "go slack and snap taut)"] if slackens.any() else []))
+    if released:
         changed = [*step.add, *step.remove]
         what = (f"{', '.join(repr(c) for c in changed)} added or removed" if changed else
                 "a release")

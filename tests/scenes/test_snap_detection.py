@@ -222,3 +222,37 @@ def test_a_heavy_bob_released_on_a_light_stiff_line_takes_the_lumped_mass(tmp_pa
     line = LINE_MASS * LINE_L * 2 * g * (1 - math.cos(THETA0))  # its inertia at most, about 1 N
     peak = float(ds.tension_max.max())
     assert bottom < peak < bottom + 1.1 * ringing + line, (peak, bottom, ringing)
+
+
+@pytest.mark.parametrize("theta_deg", [50.0, 40.0])
+def test_a_release_that_rings_a_weightless_line_through_zero_tension_takes_the_lumped_mass(
+        theta_deg):
+    """A 10 kg bob on a weightless 3 m line (0.001 kg/m, EA 1e7, 10 elements) held aside by a
+    load and let go (an independent tester's pendulum): the line's tension falls at once from
+    Mg / cos θ towards Mg cos θ and its undamped axial ringing overshoots by as much again, to
+    Mg (2 cos θ - 1 / cos θ): through zero at 50° (-37 N: it goes slack at about 4.1 ms, a
+    quarter of the ringing's period past its first half, and snaps taut), 22 N at 40°. The
+    line has no sag (λ² = 0), so only the release's own drop can tell; at 50° ``auto`` takes
+    the lumped mass, which integrates the slack (the blended one stalled there, "step size
+    collapsed"), and the line does go slack; at 40° it keeps the blended mass and the tension
+    rings down to that minimum."""
+    g, M, L, theta = 9.81, 10.0, 3.0, math.radians(theta_deg)
+    chord = L * (1 + M * g / math.cos(theta) / 1.0e7)  # stretched by the held tension
+    B = (chord * math.sin(theta), 0.0, -chord * math.cos(theta))
+    text = cable_scene(
+        B=B, L0=L, EA=1.0e7, mass=0.001, weight=0.0, elements=10, supports=("A",), gravity=g,
+        extra=point_mass("bob", M, node="B") + (
+            f'[[loads]]\nname = "hold"\nnode = "B"\nforce = [{M * g * math.tan(theta)!r}, 0.0, '
+            "0.0]\n"),
+        steps=static_step("held") + transient_step("swing", 0.008, 0.004, rtol=1e-6,
+                                                   atol=1e-8, remove=["hold"]))
+    ds = catdae.run(case_from_dict(tomllib.loads(text)))["swing"].ds
+    choice = ds.attrs["mass_model_choice"]
+    lowest = M * g * (2 * math.cos(theta) - 1 / math.cos(theta))
+    if lowest < 0:
+        assert ds.attrs["mass_model"] == "lumped", choice
+        assert "lose more than half their tension" in choice, choice
+        assert float(ds.tension_min.min()) < 0.02 * M * g  # slack
+    else:
+        assert ds.attrs["mass_model"] == "blended", choice
+        assert abs(float(ds.tension_min.min()) / lowest - 1) < 0.1, (ds.tension_min.min(), lowest)
