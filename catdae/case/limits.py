@@ -29,6 +29,9 @@ MAX_DIAMETER = 1e7  # m, of a line: its area and volume would overflow far beyon
 MAX_LINE_MASS = 1e9  # kg/m and N/m (mass, weight, damping per metre): a solid steel bar 400 m
 #                      across; far beyond, the totals (times lengths up to 1e7 m) overflow
 MAX_POINT_MASS = 1e15  # kg, of one point mass (a million supertankers)
+MAX_EA = 1e15  # N, a material's axial stiffness (a bridge's main cable is about 1e11)
+MAX_LENGTH = 1e7  # m, a cable's unstrained length, as the coordinates
+MAX_THERMAL_EXPANSION = 1e-3  # 1/K in magnitude (steel 1.2e-5, polymers about 1e-4)
 MAX_VECTOR = 1e15  # of a component of a force (N), a distributed load (N/m), a direction,
 #                   a fluid velocity: far beyond, sums and products overflow
 TABLE_ROOTS_ENV = "CATDAE_TABLE_ROOTS"  # more folders table files may be read from

@@ -14,10 +14,13 @@ from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 from catdae.case.limits import (
     MAX_COORDINATE,
     MAX_DIAMETER,
+    MAX_EA,
     MAX_ELEMENTS_PER_CABLE,
     MAX_FREQUENCY,
+    MAX_LENGTH,
     MAX_LINE_MASS,
     MAX_POINT_MASS,
+    MAX_THERMAL_EXPANSION,
     MAX_VECTOR,
     MIN_TIME,
 )
@@ -71,11 +74,12 @@ class TopSchema(BaseModel):
 
 class MaterialSchema(BaseModel):
     model_config = STRICT
-    EA: Pos
+    EA: Annotated[float, Field(gt=0, le=MAX_EA)]
     mass: Annotated[float, Field(ge=0, le=MAX_LINE_MASS)]
     weight: Annotated[float, Field(ge=0, le=MAX_LINE_MASS)] | None = None
     damping: Annotated[float, Field(ge=0, le=MAX_LINE_MASS)] = 0.0
-    thermal_expansion: float = 0.0
+    thermal_expansion: Annotated[float, Field(ge=-MAX_THERMAL_EXPANSION,
+                                              le=MAX_THERMAL_EXPANSION)] = 0.0
     # fluid properties of the line (docs/case-format.md, "Water and air")
     diameter: Annotated[float, Field(gt=0, le=MAX_DIAMETER)] | None = None
     drag_normal: NonNeg | None = None
@@ -90,7 +94,7 @@ class CableSchema(BaseModel):
     name: Name
     ends: Annotated[list[Name], Field(min_length=2, max_length=2)]
     material: Name
-    length: Pos | None = None  # exactly one of length and form (checked by the builder)
+    length: Annotated[float, Field(gt=0, le=MAX_LENGTH)] | None = None  # or form (builder)
     form: TomlTable | None = None
     elements: Elements = 1
     gauss_points: Annotated[int, Field(ge=1, le=10)] = 3

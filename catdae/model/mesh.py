@@ -86,9 +86,9 @@ class Mesh:
         bad = np.flatnonzero(per_cable <= 0.0)
         if bad.size:
             c = case.cables[int(bad[0])]
-            raise CaseError(case.path, [(f"cables.{c.name}", (
-                f"the temperature change shrinks the cable to nothing (1 + α ΔT = "
-                f"{per_cable[bad[0]]:.3g} <= 0)"))])
+            raise CaseError(case.path, [(f"materials.{c.material}.thermal_expansion", (
+                f"cable {c.name!r}: the temperature change shrinks it to nothing (1 + α ΔT = "
+                f"{per_cable[bad[0]]:.3g} <= 0); expected α in 1/K (steel about 1.2e-5)"))])
         return replace(self, L0=self.L0 * f, EA=self.EA * f, w=self.w / f, m=self.m / f,
                        c=self.c / f, s_start=self.s_start * f, thermal=f)
 

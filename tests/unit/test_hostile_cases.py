@@ -202,6 +202,22 @@ def test_a_line_diameter_beyond_the_limit_is_refused(tmp_path, capsys):
                 capsys, subprocess_check=d == 1e300)
 
 
+def test_an_axial_stiffness_a_length_or_an_expansion_beyond_the_limits_is_refused(tmp_path,
+                                                                                  capsys):
+    """EA = 1e308 and a length of 1e300 m passed check and then failed the static step with a
+    numpy overflow (exit 1, an independent tester); a thermal expansion of 1.0 (a units slip)
+    failed the run naming 'cables.c'. All are refused on read, naming the field."""
+    base = scene()
+    assert "EA = 1000000.0\n" in base and "length = 10.5\n" in base, base
+    for old, bad, field, said in (
+            ("EA = 1000000.0\n", "EA = 1e308\n", "materials.m.EA", "<= 1000000000000000.0"),
+            ("length = 10.5\n", "length = 1e300\n", "cables[0].length", "<= 10000000.0"),
+            ("mass = 1.0\n", "mass = 1.0\nthermal_expansion = 1.0\n",
+             "materials.m.thermal_expansion", "<= 0.001")):
+        invalid(base.replace(old, bad, 1), field, said, tmp_path, capsys,
+                subprocess_check=field.endswith("EA"))
+
+
 # -- 5. names: step names are netCDF group names; no control characters; mesh-node spelling ----
 def test_unsafe_step_names_are_refused(tmp_path, capsys):
     for k, name in enumerate(["$x", ".", "a\\u0000b", "-a", "a/b", "a "]):
