@@ -102,6 +102,7 @@ class ConnectorsPass:
         """The valid connectors of each section: {section: tuple of Spring/Damper/Bar}."""
         out: dict[str, tuple] = {}
         seen: dict[str, str] = {}
+        self.faulty_connectors: set[str] = set()  # not built: their problems are said
         for section in SECTIONS:
             items = []
             for i, item in enumerate(getattr(top, section)):
@@ -115,6 +116,8 @@ class ConnectorsPass:
                         continue
                     seen[nm] = f"{section}[{i}]"
                 v, ok = self.validate(_MODELS[section], item, where)
+                if isinstance(nm, str):
+                    self.faulty_connectors.add(nm)  # until it is built (below)
                 if v is None:
                     continue
                 a, b = v.ends
@@ -137,6 +140,7 @@ class ConnectorsPass:
                     fields = v.model_dump()
                     fields["ends"] = (a, b)
                     items.append(_BUILD[section](**fields))
+                    self.faulty_connectors.discard(v.name)
             out[section] = tuple(items)
         return out
 
@@ -147,6 +151,16 @@ class ConnectorsPass:
         cable, dot, _k = ref.rpartition(".")
         if dot and cable in self.cable_names:
             return self.node_ref(ref, where, cables)
+        on = next((c for c in self.cable_names if ref.startswith((f"{c}@", f"{c}."))), None)
+        if on is not None:  # a place between mesh nodes ("c@s=3.5", "c.3.5")
+            n = cables[on][1].elements if on in cables else None
+            self.problem(where, (
+                f"{ref!r} is not a node: a connector ends on a [nodes] entry or on a mesh node "
+                f"'{on}.<k>' of cable {on!r} (k = 1 to "
+                f"{'n - 1' if n is None else n - 1}, at unstrained arc length k L0 / n"
+                f"{'' if n is None else f' with its {n} elements'}); to end one at another "
+                "place, choose the cable's elements so that a mesh node falls there"))
+            return False
         choices = sorted(self.node_names) + [
             f"{n}.{k}" for n, (_, c) in cables.items() for k in range(1, min(c.elements, 100))
         ]

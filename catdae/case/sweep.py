@@ -69,7 +69,9 @@ class SweepPass:
                              f"{found_text(field)}")
                 ok = False
             elif name not in names:
-                self.problem(where + ("field",), unknown_word(name, section[:-1], sorted(names)))
+                if name not in getattr(self, "faulty_connectors", ()):  # else said already
+                    self.problem(where + ("field",),
+                                 unknown_word(name, section[:-1], sorted(names)))
                 ok = False
             else:
                 low = _CONNECTOR_FIELDS[section][attr]

@@ -11,7 +11,16 @@ import subprocess
 import sys
 from pathlib import Path
 
-from scene_toml import cable, cable_scene, load, modal_step, point_mass, static_step, transient_step
+from scene_toml import (
+    cable,
+    cable_scene,
+    damper,
+    load,
+    modal_step,
+    point_mass,
+    static_step,
+    transient_step,
+)
 
 PUSH = load("push", [0.0, 1.0, 0.0], node="c.1")
 
@@ -356,3 +365,26 @@ def test_a_static_step_with_a_mistake_is_no_unknown_jump_reference(tmp_path, cap
              + transient_step("shed", 0.1, 0.05, rtol=1e-4, atol=1e-6,
                               extra='jump_reference = "bare"\n'))
     invalid(scene(steps=steps), "steps[0].load_steps", "expected", tmp_path, capsys)
+
+
+def test_a_connector_end_between_mesh_nodes_says_how_to_place_it(tmp_path, capsys):
+    """A damper given an end between mesh nodes, "c@s=3.5" (the syntax ``catdae plot --node``
+    takes) or "c.3.5": the message says connectors end on nodes, which mesh nodes the cable has
+    and how to put one elsewhere, not "did you mean 'c.5'?" (a node 2.5 m away; "c.35" for
+    "c.3.5", 32 m away; an independent tester)."""
+    for end in ("c@s=3.5", "c.3.5"):
+        err = invalid(scene(damper("d", [end, "B"], 10.0)), "dampers[0].ends[0]",
+                      "is not a node: a connector ends on a [nodes] entry or on a mesh node "
+                      "'c.<k>' of cable 'c' (k = 1 to 3", tmp_path, capsys,
+                      subprocess_check=False)
+        assert "did you mean" not in err
+
+
+def test_a_damper_with_a_mistake_is_not_also_unknown_to_a_sweep(tmp_path, capsys):
+    """A negative damper coefficient, swept in a modal step: the coefficient is the only
+    problem said (a second, false one, "unknown damper 'd'; there is no damper at all", came
+    with every mistake in a damper)."""
+    steps = static_step("st") + ('[[steps]]\nkind = "modal"\nname = "m"\nmodes = 2\n'
+                                 'sweep = { field = "dampers.d.coefficient", values = [1.0] }\n')
+    invalid(scene(damper("d", ["c.2", "B"], -1.0), steps=steps), "dampers[0].coefficient",
+            "expected", tmp_path, capsys, subprocess_check=False)
