@@ -321,7 +321,8 @@ class Model(MassMatrices):
 
                 best = minimize_bounded(neg, lo, hi, xatol=1e-10 * mesh.L0[e])
                 best_sag = max(best_sag, -float(best[1]))
-            sag[ci] = best_sag
+            # round-off of a straight (weightless, unloaded) line is no sag
+            sag[ci] = best_sag if best_sag > 1e-12 * float(np.linalg.norm(c)) else 0.0
         unstrained = np.bincount(mesh.cable_of_element, weights=mesh.L0 / mesh.thermal,
                                  minlength=nc)
         return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag,

@@ -119,6 +119,9 @@ def _one_cable(model, X, state, els, s, p) -> dict[str, float]:
                                 s[e, j], s[e, j + 1], xtol=1e-12 * mesh.L0[e])
             d = a + 0.5 * c - (xi + _point(model, state, e, sv))  # chord point - cable, (3,)
             lateral = d[:2] - (d[:2] @ u_dir) * u_dir
+            if float(np.linalg.norm(d)) <= 1e-12 * float(np.linalg.norm(c)):
+                d = np.zeros(3)  # a straight line (weightless, unloaded): no sag, no swing
+                lateral = d[:2]  # (round-off read as 180° of swing, "sag -2.2e-16 m")
             out["sag_midspan"] = float(d[2])
             out["swing_angle"] = float(np.degrees(np.arctan2(np.linalg.norm(lateral), d[2])))
     # the lowest point, refined within a sample of the lowest sample

@@ -34,6 +34,7 @@ from cable_quadrature import (
     solve_cable,
 )
 from reference import irvine_catenary_inclined_3d
+from scene_toml import cable_scene, point_mass, static_step
 
 G = 9.81
 
@@ -364,3 +365,23 @@ def test_a_line_that_carries_no_tension_yet_is_pulled_aside(w, n, steps):
     weight = w * 20.0  # N: it tilts the line by about weight / T
     assert np.abs(ds.position.sel(node="B").values - x).max() < 20.0 * weight / T + 1e-9
     assert float(ds.tension.max()) == pytest.approx(T, abs=weight + 1e-6)
+
+
+def test_a_weightless_line_pulled_aside_is_straight_with_no_sag_or_swing():
+    """A weightless line (3 m, EA 1e7) holding a 10 kg bob pulled 40° aside: a straight line
+    along the chord (nothing loads it between its ends), so its sag, its sag at midspan and its
+    swing angle are 0 (round-off read as a sag of 4.4e-16 m and a swing of 180°, "upside
+    down", an independent tester's pendulum)."""
+    g, M, L, theta = 9.81, 10.0, 3.0, math.radians(40.0)
+    chord = L * (1 + M * g / math.cos(theta) / 1.0e7)
+    B = (chord * math.sin(theta), 0.0, -chord * math.cos(theta))
+    text = cable_scene(B=B, L0=L, EA=1.0e7, mass=0.001, weight=0.0, elements=10,
+                       supports=("A",), gravity=g, extra=point_mass("bob", M, node="B") + (
+                           f'[[loads]]\nname = "hold"\nnode = "B"\n'
+                           f"force = [{M * g * math.tan(theta)!r}, 0.0, 0.0]\n"),
+                       steps=static_step("held"))
+    ds = catdae.run(catdae.load_case(text))["held"].ds
+    assert float(ds.sag.sel(cable="c")) == 0.0
+    assert float(ds.sag_midspan.sel(cable="c")) == 0.0
+    assert float(ds.swing_angle.sel(cable="c")) == 0.0
+    np.testing.assert_allclose(float(ds.tension.max()), M * g / math.cos(theta), rtol=1e-9)
