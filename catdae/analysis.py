@@ -11,6 +11,7 @@ import copy
 import os
 import traceback
 from collections.abc import Callable, Mapping
+from contextlib import suppress
 
 import numpy as np
 
@@ -118,7 +119,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
             ds_partial = as_dataset(getattr(exc, "partial", None))
             status = f"interrupted in step '{step.name}'"
             if isinstance(ds_partial, xr.Dataset):
-                groups[step.name] = rotate_back(ds_partial, rotation)
+                groups[step.name] = _partial(step, rotate_back(ds_partial, rotation), case,
+                                             groups, temperature, on_group)
                 status += f": {ds_partial.attrs.get('status')}"
             writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
@@ -133,7 +135,8 @@ def run(case_or_path: Case | str | os.PathLike, *, output: str | os.PathLike | N
         except CatdaeError as exc:
             ds_partial = as_dataset(getattr(exc, "partial", None))
             if isinstance(ds_partial, xr.Dataset):
-                groups[step.name] = rotate_back(ds_partial, rotation)
+                groups[step.name] = _partial(step, rotate_back(ds_partial, rotation), case,
+                                             groups, temperature, on_group)
             status = f"failed in step '{step.name}': {exc}"
             writer.keep_failed(exc, results.make_tree(case, groups, status=status))
             raise
@@ -316,6 +319,17 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
         ds = results.with_note(ds, plausibility_note(model.case, waves=False))
     return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
                                   engineering.rated_strengths(model.case, model.mesh.cable_names))
+
+
+def _partial(step: Step, ds: xr.Dataset, case: Case, groups, temperature, on_group):
+    """What a failed or interrupted step computed, with the engineering results of its outputs
+    so far (envelopes, jump, swing), shown as a finished step is (``on_group``)."""
+    with suppress(Exception):  # the partial results are kept whatever happens here
+        ds = engineering_results(step, ds, case, groups, temperature)
+    with suppress(Exception):
+        if on_group is not None and step.kind == "transient":
+            on_group(step.name, ds)
+    return ds
 
 
 def engineering_results(step: Step, ds: xr.Dataset, case: Case,
