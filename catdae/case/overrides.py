@@ -97,6 +97,8 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
     else:
         connectors = {}
     done = dict(self.overrides) | {k: v for k, v in given.items() if v is not None}
+    done = {k: done[k] for k in sorted(done, key=lambda k: list(given).index(k)
+                                       if k in given else len(given))}  # one order, however given
     case = replace(self, steps=steps, cables=cables, point_masses=point_masses,
                    loads=loads, overrides=tuple(done.items()), **connectors)
     problems = size_problems(case)  # more elements: the limits are judged again
