@@ -390,7 +390,7 @@ def _modal_step(step: Step, model: Model, state: _State) -> xr.Dataset:
                                {"solver": sol.solver, "mass_model": model.mass_model.name,
                                 "mass_model_setting": model.mass_model.setting,
                                 "mass_model_choice": model.mass_model.choice,
-                                "status": "completed"})
+                                "status": "completed", "modes_requested": step.modes})
     damped = solve_damped(model, state.X, est, step.modes, step.damping)
     if damped is not None:  # docs/theory.md §16
         modes, shapes = damped

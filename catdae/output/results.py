@@ -132,6 +132,10 @@ def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, s
                   attrs: dict) -> xr.Dataset:
     """Modal step: frequencies (n_modes,) Hz and shapes (n_modes, n_nodes, 3), unit maximum."""
     n = len(frequency)
+    asked = int(attrs.get("modes_requested", n))
+    if asked > n:  # a model with fewer free degrees of freedom than modes asked for
+        attrs = {**attrs, "note": f"{asked} modes were asked for and the model has {n} (as "
+                 "many as its free degrees of freedom): all of them are given"}
     coords = _coords(mesh, with_elements=False)
     coords["mode"] = xr.Variable("mode", np.arange(1, n + 1, dtype=np.int32),
                                  {"long_name": "mode number"})
