@@ -42,11 +42,14 @@ def uniform_temperature(ds: xr.Dataset) -> float | None:
 def spans(tree: xr.DataTree, steps=None) -> Figure:
     """Sag at midspan and at the lowest point (above), the largest tension as a percentage of
     the rated strength, or else the horizontal tension along the chord (below), per cable,
-    against the steps' ``temperature`` when every step has one the same for every cable, else
-    against the steps."""
+    against the steps' ``temperature`` when every step has one the same for every cable and no
+    two steps share it, else against the steps (named, with their temperature)."""
     groups = static_groups(tree, steps)
     temps = [uniform_temperature(ds) for _, ds in groups]
-    by_temperature = all(t is not None for t in temps)
+    # against the temperature only where it tells the steps apart: load cases at one
+    # temperature (bare and iced at -5 °C) would be drawn one above the other, unnamed
+    by_temperature = (all(t is not None for t in temps)
+                      and len(set(temps)) == len(temps))
     x = np.array(temps, float) if by_temperature else np.arange(len(groups), dtype=float)
     order = np.argsort(x, kind="stable")
     fig = Figure(figsize=(8, 7))
@@ -68,7 +71,8 @@ def spans(tree: xr.DataTree, steps=None) -> Figure:
     if by_temperature:
         ax_t.set_xlabel("temperature (the case's reference_temperature units)")
     else:
-        ax_t.set_xticks(x, [name for name, _ in groups], rotation=30)
+        ax_t.set_xticks(x, [name if t is None else f"{name} ({t:g}°)"
+                            for (name, _), t in zip(groups, temps, strict=True)], rotation=30)
         ax_t.set_xlabel("static step")
     for ax in (ax_s, ax_t):
         ax.grid(True, alpha=0.3)

@@ -26,7 +26,7 @@ from catdae.output import plot_spans
 
 from reference import irvine_catenary
 from repo_paths import CASES
-from scene_toml import cable, scene
+from scene_toml import cable, cable_scene, scene
 from scene_toml import step as step_block
 
 G = 9.81
@@ -217,3 +217,29 @@ def test_per_cable_temperatures(tmp_path, capsys):
     assert one["hot"].ds.attrs["temperature_change"] == 60.0
     drawn = {ln.get_gid(): ln for ax in plot_spans.spans(one).axes for ln in ax.get_lines()}
     assert drawn["c1|sag_midspan"].get_xdata().tolist() == [15.0, 75.0]
+
+
+def test_load_cases_at_one_temperature_are_drawn_apart_in_the_spans_figure():
+    """Bare and iced at -5 °C, and hot at 50 °C (an independent tester's line): against the
+    temperature the two load cases at -5 °C would be drawn one above the other, unnamed; the
+    figure is drawn against the steps instead, each tick naming its step and temperature, and
+    the sags in step order."""
+    text = cable_scene(B=(300.0, 0.0, 0.0), L0=301.0, EA=3.0e7, mass=1.6, elements=8,
+                       head={"reference_temperature": 15.0},
+                       properties={"thermal_expansion": 1.9e-5},
+                       extra='[[distributed_loads]]\ncable = "c"\nload = [0.0, 0.0, -15.0]\n'
+                             'name = "ice"\nactive = false\n',
+                       steps=('[[steps]]\nkind = "static"\nname = "bare"\ntemperature = -5.0\n'
+                              '[[steps]]\nkind = "static"\nname = "iced"\ntemperature = -5.0\n'
+                              'add = ["ice"]\n'
+                              '[[steps]]\nkind = "static"\nname = "hot"\ntemperature = 50.0\n'
+                              'remove = ["ice"]\n'))
+    tree = catdae.run(catdae.load_case(text))
+    fig = plot_spans.spans(tree)
+    drawn = {ln.get_gid(): ln for ax in fig.axes for ln in ax.get_lines()}
+    np.testing.assert_array_equal(drawn["c|sag_midspan"].get_xdata(), [0.0, 1.0, 2.0])
+    sags = [float(tree[n].ds.sag_midspan.sel(cable="c")) for n in ("bare", "iced", "hot")]
+    np.testing.assert_array_equal(drawn["c|sag_midspan"].get_ydata(), sags)
+    assert sags[1] > sags[0]  # the ice's weight
+    ticks = [t.get_text() for t in fig.axes[1].get_xticklabels()]
+    assert ticks == ["bare (-5°)", "iced (-5°)", "hot (50°)"], ticks
