@@ -185,7 +185,8 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
         groups.append(_run_step(step_v, model, run_state, None, progress, settle=settle))
     state.__dict__.update(run_state.__dict__)
     ds = xr.concat(groups, dim="sweep", combine_attrs="drop_conflicts")
-    varying = sorted({k for g in groups for k in g.attrs} - set(ds.attrs))  # differ by value
+    varying = sorted(k for k in {k for g in groups for k in g.attrs} if k not in ds.attrs  # differ
+                     or any(k not in g.attrs for g in groups))  # by value, or some lack them
     for key in varying:
         values = [g.attrs.get(key, "") for g in groups]
         numbers = all(isinstance(v, int | float | np.number) for v in values)
@@ -326,8 +327,8 @@ def _partial(step: Step, ds: xr.Dataset, case: Case, groups, temperature, on_gro
     so far (envelopes, jump, swing), shown as a finished step is (``on_group``)."""
     with suppress(Exception):  # the partial results are kept whatever happens here
         ds = engineering_results(step, ds, case, groups, temperature)
-    with suppress(Exception):
-        if on_group is not None and step.kind == "transient":
+    if on_group is not None and step.kind == "transient":
+        with suppress(Exception):
             on_group(step.name, ds)
     return ds
 
@@ -370,8 +371,7 @@ def _thermal(case: Case) -> bool:
         or (s.sweep is not None and s.sweep.field == "temperature_change") for s in case.steps)
 
 
-def _number(x):
-    """A float, or an array of them over the values of a sweep."""
+def _number(x):  # a float, or an array of them over the values of a sweep
     return x.astype(float) if isinstance(x, np.ndarray) else float(x)
 
 

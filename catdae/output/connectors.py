@@ -85,6 +85,9 @@ def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
 
     shape = pad(np.stack([shapes.real, shapes.imag], axis=1))  # (n, 2, n_nodes, 3)
     labels = ["overdamped or not found"] * n
+    if getattr(modes, "note", ""):
+        ds = ds.assign_attrs(note="; ".join(filter(None, [ds.attrs.get("note", ""),
+                                                          modes.note])))
     return ds.assign(
         undamped_mode=var("mode", like_undamped(ds["shape"].values, shapes, n), "1",
                           "number of the undamped mode the damped mode is most like (MAC); "
