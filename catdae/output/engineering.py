@@ -20,6 +20,7 @@ import numpy as np
 from catdae._xr import xr
 from catdae.case.frame import gravity_rotation
 from catdae.output.end_peaks import with_end_note
+from catdae.output.results import with_note
 
 _SPAN = {  # name: (units, long_name)
     "horizontal_tension_along_chord": (
@@ -70,7 +71,26 @@ def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
         data["clearance"] = _cable_var(quantities["clearance"], "m", _CLEARANCE)
         data["clearance_s"] = _cable_var(quantities["clearance_s"], "m",
                                          "unstrained arc length where the clearance is least")
-    return ds.assign(data)
+    out = ds.assign(data)
+    return with_note(out, _limit_note(out, data))
+
+
+def _limit_note(ds: xr.Dataset, data: dict) -> str:
+    """What a line engineer must not miss: a cable past its rated strength, or below the
+    ground (a length given in mm read as m gave 1711 % and -155 km with no word)."""
+    names = [str(c) for c in ds.cable.values] if "cable" in ds.coords else []
+    said = []
+    pct = data.get("tension_percent_rated")
+    if pct is not None:
+        over = [(n, float(v)) for n, v in zip(names, np.ravel(pct.values), strict=False)
+                if v > 100.0]
+        said += [f"cable {n!r} is at {v:.4g} % of its rated strength (past breaking)"
+                 for n, v in over]
+    gap = data.get("clearance")
+    if gap is not None:
+        said += [f"cable {n!r} passes {-float(v):.4g} m below the ground"
+                 for n, v in zip(names, np.ravel(gap.values), strict=False) if v < 0.0]
+    return "; ".join(said)
 
 
 def cable_temperature_changes(names: list[str], change) -> np.ndarray:

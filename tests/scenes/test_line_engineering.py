@@ -26,7 +26,7 @@ from catdae.output import plot_spans
 
 from reference import irvine_catenary
 from repo_paths import CASES
-from scene_toml import cable, cable_scene, scene
+from scene_toml import cable, cable_scene, scene, static_step
 from scene_toml import step as step_block
 
 G = 9.81
@@ -243,3 +243,21 @@ def test_load_cases_at_one_temperature_are_drawn_apart_in_the_spans_figure():
     assert sags[1] > sags[0]  # the ice's weight
     ticks = [t.get_text() for t in fig.axes[1].get_xticklabels()]
     assert ticks == ["bare (-5°)", "iced (-5°)", "hot (50°)"], ticks
+
+
+@pytest.mark.parametrize("rated, ground", [(1.0e3, -5.0), (1.0e6, -20.0)])
+def test_a_cable_past_its_rated_strength_or_below_the_ground_is_noted(rated, ground):
+    """A 300 m span of 301 m (15.7 N/m; about 16 kN, its lowest point 11.4 m down): rated at
+    1 kN and over a ground 5 m down it breaks and passes through the ground, and the step's
+    note says both (a tester's length in mm read as m gave 1711 % and -155 km with no word);
+    rated at 1 MN over a ground 20 m down, nothing is said."""
+    text = cable_scene(B=(300.0, 0.0, 0.0), L0=301.0, EA=3.0e7, mass=1.6, elements=8,
+                       properties={"rated_strength": rated},
+                       extra=f"[ground]\nelevation = {ground!r}\n", steps=static_step())
+    ds = catdae.run(catdae.load_case(text))["st"].ds
+    pct = float(ds.tension_percent_rated.sel(cable="c"))
+    gap = float(ds.clearance.sel(cable="c"))
+    note = ds.attrs.get("note", "")
+    assert (f"at {pct:.4g} % of its rated strength" in note) == (pct > 100.0)
+    assert (f"passes {-gap:.4g} m below the ground" in note) == (gap < 0.0)
+    assert (pct > 100.0 and gap < 0.0) == (rated < 1e4), (pct, gap)
