@@ -73,10 +73,12 @@ def run_transient_auto(step, model: Model, state, writer, progress):
     if not why:
         return rec
     why = f"{why} (its {rec.attrs.get('n_steps', '?')} steps discarded)"
+    first = {k: rec.attrs.get(k, 0) for k in ("n_steps", "wall_time")}
     state.X, state.V, state.h, state.t = start
     lumped = Model(model.case, model.mesh, model.absent, mass_model="auto", kind=step.kind,
                    snap=why)
     rec = run_transient(step, lumped, state, writer, progress)
+    rec.attrs.update(n_steps_discarded=first["n_steps"], wall_time_discarded=first["wall_time"])
     state.snap = step.name  # a transient that continues it keeps the lumped mass
     return rec
 

@@ -184,6 +184,7 @@ def test_a_taut_rope_heaved_into_slack_and_back_is_stopped_and_run_again_lumped(
     assert "went nearly slack and snapped taut" in choice, choice
     discarded = int(re.search(r"its (\d+) steps discarded", choice)[1])
     assert discarded < 20_000, discarded  # stopped near the snap, not at the end
+    assert ds.attrs["n_steps_discarded"] == discarded and ds.attrs["wall_time_discarded"] > 0
     peak = float(ds.tension_max.max())
     assert abs(peak / 13.76e3 - 1) < 0.05, peak
     # the lumped run follows its equations (its peak is the tester's): the support's work
