@@ -231,7 +231,7 @@ def test_a_release_that_rings_a_weightless_line_through_zero_tension_takes_the_l
     """A 10 kg bob on a weightless 3 m line (0.001 kg/m, EA 1e7, 10 elements) held aside by a
     load and let go (an independent tester's pendulum): the line's tension falls at once from
     Mg / cos θ towards Mg cos θ and its undamped axial ringing overshoots by as much again, to
-    Mg (2 cos θ - 1 / cos θ): through zero at 50° (-37 N: it goes slack at about 4.1 ms, a
+    Mg (2 cos θ - 1 / cos θ): through zero at 50° (-26.5 N: it goes slack at about 4.1 ms, a
     quarter of the ringing's period past its first half, and snaps taut), 22 N at 40°. The
     line has no sag (λ² = 0), so only the release's own drop can tell; at 50° ``auto`` takes
     the lumped mass, which integrates the slack (the blended one stalled there, "step size
