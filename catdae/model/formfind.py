@@ -161,9 +161,25 @@ def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
                           f"{MAX_STRAIN:.0%}: hanging between its ends under its own weight "
                           f"its sag is at least {qmin:.6g} m")
         k = int(np.nanargmin(q))
-        return None, (f"{what} of {target:g} {unit} cannot be reached: hanging between its "
-                      f"ends under its own weight it is at least {qmin:.6g} {unit} "
-                      f"(at L0 = {ratios[k] * lc:.6g} m)")
+        # the least q lies between the samples beside the least sample: refined there, a
+        # target just above it may be reached after all (on either side of the dip)
+        from scipy.optimize import brentq, minimize_scalar
+
+        a, b = ratios[max(k - 1, 0)] * lc, ratios[min(k + 1, len(ratios) - 1)] * lc
+        best = minimize_scalar(lambda x: float(q_of(x)[0]), bounds=(a, b), method="bounded",
+                               options={"xatol": 1e-12 * lc})
+        if np.isfinite(best.fun) and best.fun <= target:
+            for side in (a, b):
+                if float(q_of(side)[0]) >= target:
+                    return float(brentq(lambda x: float(q_of(x)[0]) - target, side, best.x,
+                                        xtol=1e-14 * lc, rtol=1e-14)), ""
+        if np.isfinite(best.fun):
+            qmin, at = float(best.fun), float(best.x)
+        else:
+            at = ratios[k] * lc
+        return None, (f"{what} of {target:.9g} {unit} cannot be reached: hanging between its "
+                      f"ends under its own weight it is at least {qmin:.9g} {unit} "
+                      f"(at L0 = {at:.6g} m)")
     if kind == "sag":
         return None, (f"{what} of {target:g} m is beyond what the cable can hang: even at "
                       f"{ratios[-1]:.0f} times its chord its sag is {qmax:.6g} m")
