@@ -277,6 +277,8 @@ def solve(case: Case, evaluate) -> tuple[Case, object]:
         problems.append((f"cables[{idx[k]}].form.{c.form.kind}", (
             f"cable {names[k]!r}: the target {target[k]:.6g} {unit} cannot be reached in "
             f"the first static step with everything in it (form-finding of "
-            f"{', '.join(repr(n) for n in names)} together): the closest it came is "
-            f"{got:.6g} {unit} at L0 = {L[k]:.6g} m")))
+            f"{', '.join(repr(n) for n in names)} together): the search stopped at "
+            f"{got:.6g} {unit} at L0 = {L[k]:.6g} m, not necessarily the closest state; "
+            "targets can contradict each other (cables in series through a free node with "
+            "no load along them share one horizontal tension)")))
     raise CaseError(case.path, problems)
