@@ -37,7 +37,15 @@ def summary(ds: xr.Dataset) -> str:
     for i in range(flat.sizes["run"]):
         r = flat.isel(run=i)
         what = ", ".join(f"{d}={r[d].item()}" for d in swept) or "run"
-        lines.append(f"  {what}: {r.status.item()}, {float(r.wall_time):.3g} s, "
+        steps = f"{float(r.n_steps):.0f} steps, " if "n_steps" in r else ""
+        peak = (f", peak tension error {float(r.peak_tension_error):+.3%}"
+                if "peak_tension_error" in r else "")
+        lines.append(f"  {what}: {r.status.item()}, {float(r.wall_time):.3g} s, {steps}"
                      f"{float(r.n_residual_evaluations):.0f} residuals, error "
-                     f"{float(r.error):.3g} {ds.error.attrs['units']}")
+                     f"{float(r.error):.3g} {ds.error.attrs['units']}{peak}")
+    if "reference_elements" in ds.attrs and ds.sizes.get("elements", 1) > 1:  # automatic
+        lines.append("  (the reference is computed, not exact: the errors of the finest runs "
+                     "include its own, about theirs / (2^p - 1) for a mesh twice as fine at "
+                     "order p, as large as theirs at first order; check them against a finer "
+                     "--reference)")
     return "\n".join(lines)

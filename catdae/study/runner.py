@@ -146,6 +146,11 @@ def run_study(case: Case | str | os.PathLike, *, step: str | None = None,
                    for k in keys)
     out.attrs["status"] = "completed" if interrupt is None else (
         f"interrupted: {finished} of {len(keys)} runs finished (a partial report)")
+    if interrupt is None and out.attrs["reference_status"] != "completed":
+        out.attrs["status"] = (  # its errors are all NaN: not a completed study
+            f"reference failed ({out.attrs['reference_status']}): its errors are not to be "
+            "trusted (NaN past its last results); give --reference with settings that "
+            "complete (fewer elements, a looser rtol) or a results file")
     if interrupt is not None:
         interrupt.partial = out
         raise interrupt

@@ -320,3 +320,27 @@ def test_the_command_line_takes_max_order_auto():
 
     with pytest.raises(argparse.ArgumentTypeError, match="expected auto or 1-5"):
         _order("fast")
+
+
+def test_a_failed_reference_is_no_completed_study_and_the_table_shows_the_peak_error():
+    """A reference that did not complete (an independent tester's automatic reference stopped
+    by IDA) leaves every error NaN: the study's status says so and what to do, not
+    "completed". The printed table gives each run's steps and, for a transient, the error of
+    its peak tension (it was only in the file)."""
+    from catdae.study.report import summary
+
+    text = falling_mass(0.1, duration=0.4)
+    kw = dict(rtol=[1e-3, 1e-5], atol=[1e-9], scheduler="synchronous")
+    ds = run_study(text, **kw)
+    table = summary(ds)
+    for k, rtol in enumerate((1e-3, 1e-5)):
+        r = ds.isel(rtol=k).squeeze()
+        assert f"rtol={rtol}: completed" in table
+        assert f"{float(r.n_steps):.0f} steps" in table
+        assert f"peak tension error {float(r.peak_tension_error):+.3%}" in table
+    ref_settings = {k: ds.attrs[f"reference_{k}"] for k in study.SETTINGS}
+    ref = catdae.run(study.configure(load_case(text), "drop", ref_settings))
+    ref["drop"].attrs["status"] = "failed: IDA stopped at t = 0.3 s"
+    bad = run_study(text, reference=ref, **kw)
+    assert bad.attrs["status"].startswith("reference failed (failed: IDA stopped at t = 0.3 s)")
+    assert "give --reference" in bad.attrs["status"]
