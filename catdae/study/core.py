@@ -132,7 +132,7 @@ def reference_settings(grid: Mapping[str, list], overrides: Mapping | None = Non
     for name, values in grid.items():
         swept = len(values) > 1
         if name in ("rtol", "atol"):
-            ref[name] = min(values) / 100.0
+            ref[name] = float(f"{min(values) / 100.0:.12g}")  # 1e-07, not 1.0000000000000001e-07
         elif name == "elements":
             ref[name] = 2 * max(values) if swept else values[0]
         elif name == "gauss_points":
