@@ -56,13 +56,15 @@ def spans(tree: xr.DataTree, steps=None) -> Figure:
     ax_s, ax_t = fig.subplots(2, 1, sharex=True)
     rated = all("tension_percent_rated" in ds for _, ds in groups)
     tension = "tension_percent_rated" if rated else "horizontal_tension_along_chord"
-    for cab in (str(c) for c in groups[0][1].cable.values):
+    for k, cab in enumerate(str(c) for c in groups[0][1].cable.values):
+        color = f"C{k % 10}"  # one colour per cable in both panels (the style tells the sags)
         for var, style in (("sag_midspan", "-"), ("sag_lowest_point", "--")):
             y = np.array([float(ds[var].sel(cable=cab)) for _, ds in groups])
             ax_s.plot(x[order], y[order], style, marker="o", label=f"{cab}, {var}",
-                      gid=f"{cab}|{var}")
+                      gid=f"{cab}|{var}", color=color)
         y = np.array([float(ds[tension].sel(cable=cab)) for _, ds in groups])
-        ax_t.plot(x[order], y[order], marker="o", label=cab, gid=f"{cab}|{tension}")
+        ax_t.plot(x[order], y[order], marker="o", label=cab, gid=f"{cab}|{tension}",
+                  color=color)
     ax_s.set_ylabel("sag [m]")
     ax_s.set_title("sag at midspan (solid) and of the lowest point below the lower end (dashed)",
                    fontsize="medium")

@@ -243,6 +243,11 @@ def test_load_cases_at_one_temperature_are_drawn_apart_in_the_spans_figure():
     assert sags[1] > sags[0]  # the ice's weight
     ticks = [t.get_text() for t in fig.axes[1].get_xticklabels()]
     assert ticks == ["bare (-5°)", "iced (-5°)", "hot (50°)"], ticks
+    # one colour for the cable in both panels (the sags told apart by their line style)
+    colours = {drawn[g].get_color() for g in ("c|sag_midspan", "c|sag_lowest_point")}
+    assert len(colours) == 1 and colours == {d.get_color() for g, d in drawn.items()
+                                             if g.startswith("c|tension")
+                                             or g.startswith("c|horizontal")}, drawn
 
 
 @pytest.mark.parametrize("rated, ground", [(1.0e3, -5.0), (1.0e6, -20.0)])
