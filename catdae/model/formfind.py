@@ -165,12 +165,13 @@ def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
         # target just above it may be reached after all (on either side of the dip)
         from scipy.optimize import brentq, minimize_scalar
 
-        a, b = ratios[max(k - 1, 0)] * lc, ratios[min(k + 1, len(ratios) - 1)] * lc
+        ka, kb = max(k - 1, 0), min(k + 1, len(ratios) - 1)
+        a, b = ratios[ka] * lc, ratios[kb] * lc
         best = minimize_scalar(lambda x: float(q_of(x)[0]), bounds=(a, b), method="bounded",
                                options={"xatol": 1e-12 * lc})
         if np.isfinite(best.fun) and best.fun <= target:
-            for side in (a, b):
-                if float(q_of(side)[0]) >= target:
+            for side, q_side in ((a, q[ka]), (b, q[kb])):  # the scan's own values there
+                if q_side >= target:
                     return float(brentq(lambda x: float(q_of(x)[0]) - target, side, best.x,
                                         xtol=1e-14 * lc, rtol=1e-14)), ""
         if np.isfinite(best.fun):

@@ -53,16 +53,6 @@ def jump_floor(model, state) -> float:
     return SNAP_SHARE * t_max / impedance if impedance > 0.0 else np.inf
 
 
-def unbalance(model, state, X: np.ndarray, t0: float,
-              V: np.ndarray | None = None) -> tuple[float, int]:
-    """(the largest out-of-balance force on a free node at t0, N; that node's index): what a
-    step that starts out of equilibrium (a load or mass added or removed, a mass let go)
-    releases at once (``unbalance_forces``)."""
-    norms = np.linalg.norm(unbalance_forces(model, state, X, t0, V), axis=1)
-    k = int(np.argmax(norms))
-    return float(norms[k]), k
-
-
 def unbalance_forces(model, state, X: np.ndarray, t0: float,
                      V: np.ndarray | None = None) -> np.ndarray:
     """The residual force on each node at t0 with no acceleration, (n_nodes, 3) N (0 at the
@@ -85,7 +75,7 @@ def unbalance_forces(model, state, X: np.ndarray, t0: float,
     return r
 
 
-def release_slackens(model, state, X: np.ndarray, r: np.ndarray) -> np.ndarray:
+def release_slackens(model, X: np.ndarray, r: np.ndarray, t_end: np.ndarray) -> np.ndarray:
     """Elements whose tension a start out of balance can take to zero, (n_elem,) bool. The net
     force -r_k on a node k, let go at once, changes the tension of each element at k by its
     part along the element, drop = -r_k · ĉ (ĉ from k towards the element's other end) at the
@@ -93,11 +83,9 @@ def release_slackens(model, state, X: np.ndarray, r: np.ndarray) -> np.ndarray:
     tension falls to about T - 2 drop, which is below zero when the drop is more than half the
     tension (a bob held 50° aside on a light line and let go: 152.6 N falls towards 63 N and
     rings through zero). Whatever the element's λ² (a weightless line has none) it then goes
-    slack and snaps taut again."""
+    slack and snaps taut again. ``t_end`` (n_elem, 2): the tensions at ends i and j."""
     conn = model.mesh.conn
-    t_end = model.tensions(state)  # (n_elem, 2): at end i, at end j
-    c = np.reshape(X, (-1, 3))[conn[:, 1]] - np.reshape(X, (-1, 3))[conn[:, 0]]
-    c /= np.maximum(np.linalg.norm(c, axis=1), 1e-300)[:, None]
+    c = model.unit_chords(X)
     drop_i = np.einsum("ej,ej->e", -r[conn[:, 0]], c)  # end i: towards j is +ĉ
     drop_j = np.einsum("ej,ej->e", -r[conn[:, 1]], -c)
     return (t_end[:, 0] < 2.0 * drop_i) | (t_end[:, 1] < 2.0 * drop_j)
@@ -134,13 +122,14 @@ def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
     sag = lam2 > SAG_LAMBDA2
     amp = np.where(sag, 0.0, sag_amplification(model, state, X))
     breathes = amp > SAG_AMPLIFICATION
-    t_max = float(model.tensions(state).max(initial=0.0))
+    t_end = model.tensions(state)
+    t_max = float(t_end.max(initial=0.0))
     r = unbalance_forces(model, state, X, t0, V)
     norms = np.linalg.norm(r, axis=1)
     node = int(np.argmax(norms))
     force = float(norms[node])
     released = force >= SNAP_SHARE * t_max
-    slackens = (release_slackens(model, state, X, r) & ~sag & ~breathes if released
+    slackens = (release_slackens(model, X, r, t_end) & ~sag & ~breathes if released
                 else np.zeros(lam2.size, bool))
     if not (sag.any() or breathes.any() or slackens.any()):
         return ""

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
-from catdae.output.results import label, var
+from catdae.output.results import label, var, with_note
 
 
 def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
@@ -85,9 +85,7 @@ def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
 
     shape = pad(np.stack([shapes.real, shapes.imag], axis=1))  # (n, 2, n_nodes, 3)
     labels = ["overdamped or not found"] * n
-    if getattr(modes, "note", ""):
-        ds = ds.assign_attrs(note="; ".join(filter(None, [ds.attrs.get("note", ""),
-                                                          modes.note])))
+    ds = with_note(ds, getattr(modes, "note", ""))
     return ds.assign(
         undamped_mode=var("mode", like_undamped(ds["shape"].values, shapes, n), "1",
                           "number of the undamped mode the damped mode is most like (MAC); "

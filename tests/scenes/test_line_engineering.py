@@ -262,6 +262,10 @@ def test_a_cable_past_its_rated_strength_or_below_the_ground_is_noted(rated, gro
     ds = catdae.run(catdae.load_case(text))["st"].ds
     pct = float(ds.tension_percent_rated.sel(cable="c"))
     gap = float(ds.clearance.sel(cable="c"))
+    # the elastic catenary's closed form: the end tension, and the lowest point at midspan
+    sag, H = level_span(301.0, 3.0e7, 1.6 * 9.81, 0.0, 300.0)
+    assert pct == pytest.approx(100 * math.hypot(H, 0.5 * 1.6 * 9.81 * 301.0) / rated, rel=1e-6)
+    assert gap == pytest.approx(-sag - ground, abs=1e-6)
     note = ds.attrs.get("note", "")
     assert (f"at {pct:.4g} % of its rated strength" in note) == (pct > 100.0)
     assert (f"passes {-gap:.4g} m below the ground" in note) == (gap < 0.0)

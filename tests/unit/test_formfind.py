@@ -137,26 +137,14 @@ def test_newton_reports_targets_it_cannot_reach():
     assert "cannot be reached" in message and "4000" in message
 
 
-STEEP = """
-[materials.m]
-EA = 1.0e7
-mass = 1.5
-[nodes]
-A = [0.0, 0.0, 0.0]
-B = [100.0, 0.0, 80.0]
-[supports]
-A = "pinned"
-B = "pinned"
-[[cables]]
-name = "c"
-ends = ["A", "B"]
-material = "m"
-form = { tension = TARGET, at = "A" }
-elements = 8
-[[steps]]
-kind = "static"
-name = "eq"
-"""
+def _steep(target: float) -> str:
+    """A 100 m span rising 80 m (1.5 kg/m, EA 1e7), its length form-found from the tension at
+    its lower end A."""
+    return scene(materials={"m": {"EA": 1.0e7, "mass": 1.5}},
+                 nodes={"A": [0.0, 0.0, 0.0], "B": [100.0, 0.0, 80.0]},
+                 cables=[cable("c", ("A", "B"), "m", None, 8,
+                               form={"tension": target, "at": "A"})],
+                 steps=static_step("eq"))
 
 
 def test_a_tension_target_just_above_the_least_one_is_reached():
@@ -165,11 +153,11 @@ def test_a_tension_target_just_above_the_least_one_is_reached():
     catenary. A target of 719.18 N, between two scanned lengths whose tensions are both above
     it, was refused ("at least 719.202 N"); it is reached (at L0 = 153.746 m, the tester's),
     and 719.16 N is refused quoting the least tension to 1e-6."""
-    tree = catdae.run(catdae.load_case(STEEP.replace("TARGET", "719.18")))
+    tree = catdae.run(catdae.load_case(_steep(719.18)))
     ds = tree["eq"].ds
     assert float(ds.cable_end_tension.sel(cable="c", end="i")) == pytest.approx(719.18, rel=1e-9)
     assert float(ds.unstrained_length.sel(cable="c")) == pytest.approx(153.746, abs=1e-3)
     with pytest.raises(CaseError) as err:
-        catdae.run(catdae.load_case(STEEP.replace("TARGET", "719.16")))
+        catdae.run(catdae.load_case(_steep(719.16)))
     least = float(str(err.value).split("at least ")[1].split(" N")[0])
     assert least == pytest.approx(719.171, abs=2e-3)
