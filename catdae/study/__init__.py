@@ -45,7 +45,9 @@ or ``<cable>.<k>`` meaning node k of the case file's own mesh (fraction k/elemen
 the largest distance over the reference's output times between the run's displacement there
 (interpolated linearly in time) and the reference's, in m. For a modal step it is the largest
 relative error of the lowest natural frequencies (``response``: how many; default the step's
-``modes``), with the signed errors per mode in ``frequency_error``.
+``modes``), with the signed errors per mode in ``frequency_error``: each reference mode is
+paired with the run's mode of the same shape (``catdae.study.modes``; ``matched_mode``,
+``shape_correlation``), and one the run does not resolve makes its error inf.
 A modal ``response`` ``"frequency:<k>"`` takes mode k's error alone; a static study step
 (settings ``elements``, ``gauss_points``) measures the relative error of one static quantity
 of a cable, ``"<quantity>:<cable>"`` (``catdae.study.quantity``).

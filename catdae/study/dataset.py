@@ -8,7 +8,7 @@ import numpy as np
 
 from catdae._xr import xr
 from catdae.case import Step
-from catdae.study import quantity
+from catdae.study import modes, quantity
 from catdae.study.core import CHOICES, COORD_META, COUNTS, MEMORY_NAMES
 
 
@@ -45,7 +45,10 @@ def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     elif st.kind == "modal":
         n_modes = single or target
         ref_f = ref.frequency.values[:n_modes] if ref_ok else np.full(n_modes, np.nan)
+        n_modes = ref_f.size if ref_ok else n_modes
         ferr = np.full((*shape, n_modes), np.nan)
+        paired = np.zeros((*shape, n_modes), int)  # the run's mode number; 0: none
+        mac = np.full((*shape, n_modes), np.nan)
     for combo, key in zip(combos, keys, strict=True):
         idx = tuple(grid[n].index(combo[n]) for n in names)
         rec = records[key]
@@ -60,10 +63,16 @@ def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
             data["peak_tension_error"][idx] = (float(rec.attrs.get("peak_tension", math.nan))
                                                / ref_peak - 1.0)
         elif st.kind == "modal":
-            f = rec.frequency.values[:n_modes]
-            ferr[idx][: f.size] = (f - ref_f[: f.size]) / ref_f[: f.size]
-            data["error"][idx] = float(abs(ferr[idx][single - 1]) if single
-                                       else np.nanmax(np.abs(ferr[idx])))
+            pair, score = modes.match(ref, rec)
+            pair, score = pair[:n_modes], score[:n_modes]
+            found = pair >= 0
+            f = rec.frequency.values[np.maximum(pair, 0)]
+            ferr[idx] = np.where(found, (f - ref_f) / ref_f, np.nan)
+            paired[idx], mac[idx] = pair + 1, np.where(found, score, np.nan)
+            # a mode the run does not resolve: no finite error (the run misses what is asked)
+            compared = [single - 1] if single else range(n_modes)
+            data["error"][idx] = (math.inf if not found[compared].all()
+                                  else float(np.abs(ferr[idx][compared]).max()))
     if st.kind == "static" and ref_ok:
         quantity.static_errors(records, combos, keys, grid, ref, target, data)
     dims = tuple(names)
@@ -108,11 +117,23 @@ def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
                                                  {"long_name": "mode number"}))
         out["frequency_error"] = xr.Variable(
             (*dims, "mode"), ferr, {"units": "1", "long_name": "relative error of the natural "
-                                    "frequency (f - f_ref) / f_ref"})
+                                    "frequency (f - f_ref) / f_ref of the run's mode of the "
+                                    "same shape (NaN: the run has none)"})
+        out["matched_mode"] = xr.Variable(
+            (*dims, "mode"), paired, {"long_name": "the run's mode paired with the "
+                                      "reference's mode by shape (0: none within 45 degrees)"})
+        out["shape_correlation"] = xr.Variable(
+            (*dims, "mode"), mac, {"units": "1", "long_name": "modal assurance criterion of "
+                                   "the pair, the squared cosine of the angle between shapes"})
+        if single:
+            out.attrs["response_mode"] = single
         out.attrs["response"] = (f"natural frequency of mode {single}" if single
                                  else f"{n_modes} lowest natural frequencies")
-        out.attrs["error_definition"] = (f"|f - f_ref| / f_ref of mode {single}" if single
-                                         else "max over the modes of |f - f_ref| / f_ref")
+        out.attrs["error_definition"] = (
+            (f"|f - f_ref| / f_ref of mode {single}" if single
+             else "max over the modes of |f - f_ref| / f_ref")
+            + ", f the run's mode of the reference mode's shape (modal assurance criterion); "
+            "inf when the run has no mode of that shape")
     elif st.kind == "static":
         out.attrs["response"] = quantity.describe(target)
         out.attrs["error_definition"] = "|q - q_ref| / |q_ref|"

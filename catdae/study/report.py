@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from catdae._xr import xr
 from catdae.output.results import write_atomic
 from catdae.study.core import SETTINGS
@@ -32,17 +34,30 @@ def summary(ds: xr.Dataset) -> str:
     swept = [d for d in SETTINGS if d in ds.dims and ds.sizes[d] > 1]
     lines = [f"study of step '{ds.attrs['step']}' of {ds.attrs['case_name']}: response "
              f"{ds.attrs['response']}; reference {ds.attrs['reference']}"]
-    flat = ds.drop_vars([v for v in ("frequency_error",) if v in ds]).stack(run=list(
-        d for d in SETTINGS if d in ds.dims))
+    per_mode = [v for v in ("frequency_error", "matched_mode", "shape_correlation") if v in ds]
+    flat = ds.drop_vars(per_mode).stack(run=list(d for d in SETTINGS if d in ds.dims))
+    units = ds.error.attrs["units"]
+    matched = (ds.matched_mode.stack(run=list(flat.indexes["run"].names))
+               if "matched_mode" in ds else None)
     for i in range(flat.sizes["run"]):
         r = flat.isel(run=i)
         what = ", ".join(f"{d}={r[d].item()}" for d in swept) or "run"
-        steps = f"{float(r.n_steps):.0f} steps, " if "n_steps" in r else ""
+        counts = "".join(f", {float(r[v]):.0f} {name}" for v, name in (
+            ("n_steps", "steps"), ("n_residual_evaluations", "residuals"))
+            if v in r and np.isfinite(float(r[v])))
         peak = (f", peak tension error {float(r.peak_tension_error):+.3%}"
                 if "peak_tension_error" in r else "")
-        lines.append(f"  {what}: {r.status.item()}, {float(r.wall_time):.3g} s, {steps}"
-                     f"{float(r.n_residual_evaluations):.0f} residuals, error "
-                     f"{float(r.error):.3g} {ds.error.attrs['units']}{peak}")
+        err = f"error {float(r.error):.3g}" + (f" {units}" if units != "1" else "")
+        if matched is not None and r.status.item() == "completed":
+            missing = [str(m) for m, k in zip(ds.mode.values, matched.isel(run=i).values,
+                                              strict=True)
+                       if k == 0 and ds.attrs.get("response_mode", m) == m]
+            if missing:
+                err += (f" (no mode of the shape of the reference's mode"
+                        f"{'s' if len(missing) > 1 else ''} {', '.join(missing)}: this run "
+                        "does not resolve it)")
+        lines.append(f"  {what}: {r.status.item()}, {float(r.wall_time):.3g} s{counts}, "
+                     f"{err}{peak}")
     if "reference_elements" in ds.attrs and ds.sizes.get("elements", 1) > 1:  # automatic
         lines.append("  (the reference is computed, not exact: the errors of the finest runs "
                      "include its own, about theirs / (2^p - 1) for a mesh twice as fine at "

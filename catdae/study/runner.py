@@ -35,6 +35,7 @@ from catdae.study.core import (
     study_step,
 )
 from catdae.study.dataset import assemble
+from catdae.study.modes import mode_samples
 from catdae.study.quantity import frequency_target, static_target, static_values
 from catdae.study.store import clean, store_read, store_write
 from catdae.study.worker import MemoryProbe, peak_tension
@@ -218,11 +219,9 @@ def _given_reference(reference, st: Step, case: Case, duration=None) -> xr.Datas
         return static_values(ds, attrs)
     if st.kind == "transient":
         attrs["peak_tension"] = peak_tension(ds)
-    if st.kind == "modal":
-        if "frequency" not in ds:
-            raise StudyError(f"{where}: a modal study needs a 'frequency' variable")
-        return xr.Dataset({"frequency": ("mode", ds.frequency.values)}, attrs=attrs)
-    if "displacement" not in ds:
+    if st.kind == "modal" and ("frequency" not in ds or "shape" not in ds):
+        raise StudyError(f"{where}: a modal study needs 'frequency' and 'shape' variables")
+    if st.kind == "transient" and "displacement" not in ds:
         raise StudyError(f"{where}: a transient study needs a 'displacement' variable")
     names = [str(n) for n in ds.node.values]
     counts: dict[str, int] = {}
@@ -232,6 +231,8 @@ def _given_reference(reference, st: Step, case: Case, duration=None) -> xr.Datas
             counts[cable] = counts.get(cable, 1) + 1
     ref_case = replace(case, cables=tuple(replace(c, elements=counts.get(c.name, 1))
                                           for c in case.cables))
+    if st.kind == "modal":
+        return mode_samples(ref_case, ds, attrs)
     labels = point_labels(ref_case, names)
     keep = [i for i, lab in enumerate(labels) if lab is not None]
     return xr.Dataset(

@@ -13,6 +13,7 @@ from catdae.analysis import run
 from catdae.case import AXES, Case, Step
 from catdae.errors import CatdaeError
 from catdae.study.core import COUNTS, StudyError, point_labels
+from catdae.study.modes import mode_samples
 
 _WARMED: set[tuple] = set()  # kinds of step already run once in this process
 
@@ -21,7 +22,8 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
     """Run a configured case and return the study step's response and costs.
 
     The Dataset holds ``displacement``(time, point, axis) at every node, labelled by
-    :func:`point_labels` (transient), or ``frequency``(mode) (modal), and attrs ``status``,
+    :func:`point_labels` (transient), or ``frequency``(mode) and ``shape`` (modal,
+    :func:`catdae.study.modes.mode_samples`), and attrs ``status``,
     ``wall_time``, ``peak_memory`` and the transient's evaluation counts (NaN when absent).
     Analysis failures become a status, never an exception.
     """
@@ -58,7 +60,7 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
     if group is None or status != "completed":
         return xr.Dataset(attrs=attrs)
     if step.kind == "modal":
-        return xr.Dataset({"frequency": ("mode", group.frequency.values)}, attrs=attrs)
+        return mode_samples(case_run, group, attrs)
     if step.kind == "static":
         from catdae.study.quantity import static_values
 
