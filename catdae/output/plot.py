@@ -26,19 +26,15 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from catdae._xr import xr
-from catdae.errors import CatdaeError
 from catdae.interrupts import deferred
 from catdae.output.environment import axis_names, drawing_frame, still_levels
 from catdae.output.plot_envelopes import mark_peaks, reactions
-from catdae.output.plot_parts import draw_connectors, label, legend
+from catdae.output.plot_parts import PlotError, draw_connectors, label, legend
+from catdae.output.plot_parts import output_times as _times
 from catdae.output.plot_parts import subplots as _subplots
 from catdae.output.reading import ratio_text
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
-
-
-class PlotError(CatdaeError):
-    """A figure that the data cannot make (no such node, step or time)."""
 
 
 _KINDS = {"profile": ("static", "transient"), "tension": ("static", "transient"),
@@ -88,21 +84,6 @@ def _paths(ds: xr.Dataset) -> dict[str, list[str]]:
     cab = ds.node_cable.values
     return {str(c): [str(n) for n in ds.node.values[cab == c]] for c in dict.fromkeys(cab)
             if c}
-
-
-def _times(ds: xr.Dataset, times) -> np.ndarray:
-    """The stored times nearest to the requested ones (default: 5 spread over the step)."""
-    t = ds.time.values
-    if times is None:
-        return t[np.unique(np.linspace(0, t.size - 1, min(5, t.size)).round().astype(int))]
-    try:
-        wanted = np.atleast_1d(np.asarray(times, dtype=float))
-    except (TypeError, ValueError):
-        raise PlotError(f"times: expected numbers (s), found {times!r:.60}") from None
-    if wanted.ndim != 1 or wanted.size == 0 or not np.isfinite(wanted).all():
-        raise PlotError(f"times: expected one or more finite times (s), found "
-                        f"{np.array2string(wanted, threshold=6)}")
-    return np.array([t[np.abs(t - x).argmin()] for x in wanted])
 
 
 def profile(data, times=None, what: str = "position") -> Figure:

@@ -7,6 +7,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from catdae._xr import xr
+from catdae.errors import CatdaeError
+
+
+class PlotError(CatdaeError):
+    """A figure that the data cannot make (no such node, step or time)."""
 
 
 def label(var: xr.DataArray, name: str | None = None) -> str:
@@ -46,3 +51,22 @@ def draw_connectors(ax_e, ax_p, ds: xr.Dataset, x: xr.DataArray, R, t) -> None:
                   label=tag, gid=f"{name}|{t}")
         ax_p.plot(pts[:, 0], pts[:, 1], ls="--", marker="o", ms=3, lw=1.2, color="0.35",
                   gid=f"{name}|{t}")
+
+
+def output_times(ds: xr.Dataset, times) -> np.ndarray:
+    """The stored times nearest to the requested ones (default: 5 spread over the step)."""
+    t = ds.time.values
+    if times is None:
+        return t[np.unique(np.linspace(0, t.size - 1, min(5, t.size)).round().astype(int))]
+    try:
+        wanted = np.atleast_1d(np.asarray(times, dtype=float))
+    except (TypeError, ValueError):
+        raise PlotError(f"times: expected numbers (s), found {times!r:.60}") from None
+    half = 0.5 * float(np.diff(t).max()) if t.size > 1 else 0.0  # nearest output within reach
+    if wanted.ndim != 1 or wanted.size == 0 or not np.isfinite(wanted).all():
+        why = "expected one or more finite times (s)"
+    elif ((wanted < t[0] - half) | (wanted > t[-1] + half)).any():
+        why = f"the step's outputs run from {t[0]:g} to {t[-1]:g} s (--step picks the step)"
+    else:
+        return np.array([t[np.abs(t - x).argmin()] for x in wanted])
+    raise PlotError(f"times: {why}, found {np.array2string(wanted, threshold=6)}")

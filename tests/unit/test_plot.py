@@ -48,6 +48,20 @@ def test_profile_draws_each_cable_through_its_nodes_in_order(ex1):
     assert ax_e.get_ylabel().endswith("z [m]") and ax_p.get_xlabel().endswith("x [m]")
 
 
+def test_times_outside_the_step_are_refused_with_its_span(ex1):
+    """A time past the step's last output was drawn silently as the last output."""
+    tree, _ = ex1
+    ds = tree["release"].to_dataset()
+    t_end = float(ds.time[-1])
+    step = float(ds.time[1] - ds.time[0])
+    with pytest.raises(plot.PlotError, match=f"run from 0 to {t_end:g} s"):
+        plot.profile(ds, times=[1.0, t_end + 3.0])
+    with pytest.raises(plot.PlotError, match="run from"):
+        plot.tension(ds, times=[-step])
+    fig = plot.profile(ds, times=[t_end + 0.4 * step])  # the nearest output is within reach
+    assert _lines(fig.axes[0], f"main|{t_end}")
+
+
 def test_profile_of_a_network_draws_the_shared_node_on_every_cable():
     tree = catdae.run(THREE, progress=False)
     ds = tree["equilibrium"].to_dataset()
