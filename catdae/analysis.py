@@ -32,7 +32,7 @@ from catdae.model.snap import snap_reason
 from catdae.model.span import span_quantities
 from catdae.output import engineering, results
 from catdae.output.connectors import with_connector_forces, with_damped_modes
-from catdae.output.fluid import with_static_fluid
+from catdae.output.fluid import effective_tension, with_static_fluid
 from catdae.output.transient import as_dataset
 from catdae.output.writer import ResultWriter
 from catdae.solvers.damped_modes import solve_damped
@@ -360,7 +360,7 @@ def engineering_results(step: Step, ds: xr.Dataset, case: Case,
         ds = engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
     if step.kind != "modal" and names and _thermal(case):
         ds = engineering.add_temperatures(ds, names, temperature, case.reference_temperature)
-    return ds
+    return effective_tension(ds, case.water is not None)
 
 
 def _thermal(case: Case) -> bool:

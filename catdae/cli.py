@@ -149,6 +149,11 @@ def _check(args) -> int:
     mesh = check_case(case)
     say(f"{args.case}: valid: {len(case.cables)} cable(s), {mesh.n_elements} elements, "
         f"{mesh.n_nodes} nodes, {len(case.steps)} step(s)")
+    from catdae.model.fluid import plausibility_note
+
+    # what catdae run would note of the water (a slip of units shows here, before the run)
+    if note := plausibility_note(case, waves=any(s.kind == "transient" for s in case.steps)):
+        say(f"{args.case}: note: {note}")
     return 0
 
 

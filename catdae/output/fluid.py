@@ -42,3 +42,22 @@ def with_static_fluid(ds: xr.Dataset, fluid: Fluid | None, X: np.ndarray, t: flo
     out["fluid_velocity"] = var(("node", "axis"), vel, "m/s", "velocity of the still water "
                                  "(below the surface) or the air at the node")
     return out
+
+
+EFFECTIVE = ("effective tension, as everywhere in water: the wall tension is T_wall = T - p A, "
+             "p the water pressure at that depth (docs/case-format.md, Effective tension)")
+
+
+def effective_tension(ds: xr.Dataset, in_water: bool) -> xr.Dataset:
+    """``ds`` with its tensions (N) named effective where the case has water: the catenary of
+    the submerged weight carries the effective tension, not the wall tension (theory §13.1)."""
+    if not in_water:
+        return ds
+    out = ds.copy()
+    for name, v in out.data_vars.items():
+        if "tension" in str(name) and v.attrs.get("units") == "N":
+            text = str(v.attrs.get("long_name", name))
+            text = (text.replace("cable tension", "effective cable tension", 1)
+                    if "cable tension" in text else text.replace("tension", "effective tension", 1))
+            out[name].attrs.update(long_name=text, comment=EFFECTIVE)
+    return out

@@ -170,9 +170,16 @@ def _span_lines(ds, k: int) -> list[str]:
     low = float(ds.sag_lowest_point.values[k])
     if abs(low) < 1e-9 * max(abs(mid), 1.0):  # rounding of a lowest point at the end: 0
         low = 0.0
-    parts = [f"sag at midspan {mid:.6g} m",
-             f"at the lowest point {low:.6g} m below the lower end",
-             f"swing angle {_deg(float(ds.swing_angle.values[k]))} deg"]
+    swing = float(ds.swing_angle.values[k])
+    if not (np.isfinite(mid) or np.isfinite(swing)):  # engineering.py: NaN for a vertical chord
+        parts = ["vertical chord: no sag at midspan or swing angle (no vertical plane through "
+                 "the chord; the largest offset from it is the sag above)",
+                 f"lowest point {low:.6g} m below the lower end"]
+    else:
+        parts = [f"sag at midspan {mid:.6g} m" + (" (above the chord: the cable bulges up)"
+                                                   if mid < 0 else ""),
+                 f"at the lowest point {low:.6g} m below the lower end",
+                 f"swing angle {_deg(swing)} deg"]
     parts += _rated(ds, k)
     if "clearance" in ds:
         parts.append(f"clearance above the ground {float(ds.clearance.values[k]):.6g} m at "

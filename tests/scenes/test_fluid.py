@@ -453,7 +453,7 @@ def test_drag_through_the_surface_only_takes_energy(mass_model):
     assert min(powers) < 0.0
 
 
-def _riser(waves=None, current=None) -> str:
+def _riser(waves=None, current=None, water: bool = True) -> str:
     """A taut riser from a 60 m deep floor to 2 m below the surface, 6 elements, in 60 m of
     water with ``waves`` and ``current`` (fields of [water]); a static step, then 0.05 s."""
     return scene(materials={"riser": {"EA": 1.0e10, "mass": 300.0, "diameter": 0.5}},
@@ -461,7 +461,7 @@ def _riser(waves=None, current=None) -> str:
                  supports=("bottom", "top"),
                  cables=cable("riser", ("bottom", "top"), "riser", 57.99, 6),
                  extra=section("water", density=1025.0, depth=60.0, waves=waves,
-                               current=current),
+                               current=current) if water else "",
                  steps=static_step("still") + step("transient", "waves", duration=0.05,
                                                    output_interval=0.05))
 
@@ -486,6 +486,23 @@ def test_a_wave_beyond_breaking_is_noted(height, breaking):
     assert "breaking" not in tree["still"].ds.attrs.get("note", "")  # still water there
 
 
+def test_check_says_what_the_run_would_note_of_the_water(tmp_path, capsys):
+    """`catdae check` passed a 40 m wave (limit 33.6 m, above) and a 12 m/s current silently:
+    a slip of units should show before the run. Still valid (exit 0), with the note."""
+    from catdae.cli import main
+
+    for i, (waves, current, said) in enumerate([
+            ({"kind": "airy", "height": 40.0, "period": 14.0}, None, "above the breaking limit"),
+            (None, [12.0, 0.0, 0.0], "the current reaches 12 m/s"),
+            ({"kind": "airy", "height": 30.0, "period": 14.0}, [1.5, 0.0, 0.0], None)]):
+        path = tmp_path / f"riser{i}.toml"
+        path.write_text(_riser(waves=waves, current=current))
+        assert main(["check", str(path)]) == 0
+        out = capsys.readouterr().out
+        assert "valid" in out
+        assert (said in out) if said else ("note" not in out), out
+
+
 def test_a_current_faster_than_any_sea_is_noted_and_a_nan_one_shown():
     """A current of 12 m/s (a slip of units) is named in the static note; a NaN component is
     shown in the message as it was given (it said only "an array of 3 items")."""
@@ -495,3 +512,21 @@ def test_a_current_faster_than_any_sea_is_noted_and_a_nan_one_shown():
     assert "note" not in calm["still"].ds.attrs
     with pytest.raises(catdae.CaseError, match=r"found the array \[nan, 0\.0, 0\.0\]"):
         load_case(_riser(current=[math.nan, 0.0, 0.0]))
+
+
+def test_tensions_in_water_are_named_effective():
+    """The catenary of the submerged weight carries the effective tension (the wall tension
+    is T - p A): a riser engineer reading only the file took `tension` for wall tension. In
+    water every tension variable says so; in air nothing changes."""
+    tree = catdae.run(load_case(_riser(current=[1.0, 0.0, 0.0])))
+    for group in ("still", "waves"):
+        ds = tree[group].ds
+        named = [v for v in ds.data_vars if "tension" in v and ds[v].attrs.get("units") == "N"]
+        assert {"tension", "cable_end_tension" if group == "still" else "tension_max"} <= set(
+            named)
+        for v in named:
+            assert "effective" in ds[v].attrs["long_name"], (group, v)
+            assert "T_wall = T - p A" in ds[v].attrs["comment"]
+    assert tree["waves"].ds.tension_max.attrs["long_name"].startswith("largest effective")
+    dry = catdae.run(load_case(_riser(water=False)))
+    assert "effective" not in dry["still"].ds.tension.attrs["long_name"]

@@ -95,3 +95,29 @@ def test_still_air_reads_plainly(tmp_path, capsys):
     assert "(includes the part across the chord)" in lines["windy"]
     windy = tree["windy"].to_dataset()
     assert f"swing angle {float(windy.swing_angle.sel(cable='span')):.6g} deg" in spans["windy"]
+
+
+def test_a_vertical_chord_and_an_upward_bulge_are_said(tmp_path, capsys):
+    """A vertical line has no vertical plane through its chord, so no midspan sag or swing
+    angle: the summary printed 'sag at midspan nan m; swing angle nan deg' with no word of why.
+    A weightless line pushed up across its chord hangs above it: sag < 0, swing 180 degrees,
+    said as a bulge (the tester read 180 degrees as a fault)."""
+    vertical = tmp_path / "vertical.toml"
+    vertical.write_text(cable_scene(B=(0.0, 0.0, -50.0), L0=50.0, EA="1e9", mass=10.0,
+                                    elements=4, title="hanging vertical", steps=static_step()))
+    assert main(["run", str(vertical), "-o", str(tmp_path / "v.nc"), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    ds = catdae.read_results(tmp_path / "v.nc")["st"].to_dataset()
+    assert math.isnan(float(ds.sag_midspan.values[0]))
+    assert "vertical chord: no sag at midspan or swing angle" in text and " nan " not in text
+    up = tmp_path / "up.toml"
+    up.write_text(cable_scene(B=(50.0, 0.0, 0.0), L0=49.95, EA="1e8", mass=1.0, gravity=0.0,
+                              elements=4, title="pushed up",
+                              extra=distributed_load("c", [0.0, 0.0, 20.0], name="lift"),
+                              steps=static_step()))
+    assert main(["run", str(up), "-o", str(tmp_path / "u.nc"), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    ds = catdae.read_results(tmp_path / "u.nc")["st"].to_dataset()
+    mid = float(ds.sag_midspan.values[0])
+    assert mid < 0 and float(ds.swing_angle.values[0]) == pytest.approx(180.0)
+    assert f"sag at midspan {mid:.6g} m (above the chord: the cable bulges up)" in text
