@@ -1,6 +1,7 @@
 """What the steps need of the scene, judged before any work (``catdae run`` and ``catdae
 check``): inertia at every free node of a transient, stiffness at every node a damper reaches,
-and no sweep of a form-finding step."""
+a support for every part of the scene a static or modal step must balance, and no sweep of a
+form-finding step."""
 
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ def check_steps(case: Case, mesh) -> None:
         problems.append(("steps[0].sweep", "the first static step finds the cables' lengths "
                          "(form-finding) and cannot be swept; sweep a later step"))
     problems += _damper_only_nodes(case, mesh)
+    problems += _unheld_parts(case, mesh)
     absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
               if not x.active}
     for i, step in enumerate(case.steps):
@@ -65,4 +67,40 @@ def _damper_only_nodes(case: Case, mesh) -> list[tuple[str, str]]:
                  "spring or bar reaches it, and it is not a support): a damper has no "
                  "stiffness, so the node has no static equilibrium; support it, or join it "
                  "with a spring or a bar") for e in loose]
+    return out
+
+
+def _unheld_parts(case: Case, mesh) -> list[tuple[str, str]]:
+    """Parts of the scene (nodes joined by cables, springs and bars) with no support, when a
+    static or modal step must balance them: they have no equilibrium, and the step failed late
+    (200 Newton iterations, "ramped up to 0 %"; or "not stable") without naming them. A
+    transient alone may let a part fall on purpose; a seabed may hold what rests on it."""
+    if case.seabed is not None or not any(s.kind in ("static", "modal") for s in case.steps):
+        return []
+    parent = list(range(mesh.n_nodes))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    pairs = [tuple(e) for e in mesh.conn]
+    pairs += [tuple(mesh.node_index(e) for e in c.ends) for c in (*case.springs, *case.bars)]
+    for a, b in pairs:
+        parent[root(int(a))] = root(int(b))
+    held = {root(mesh.node_index(n)) for n, axes in case.supports.items() if axes}
+    out = []
+    for i, c in enumerate(case.cables):
+        part = root(mesh.node_index(c.ends[0]))
+        if part in held:
+            continue
+        held.add(part)  # say it once per part
+        names = [x.name for x in case.cables if root(mesh.node_index(x.ends[0])) == part]
+        shown = ", ".join(repr(n) for n in names[:5]) + (
+            f" and {len(names) - 5} more" if len(names) > 5 else "")
+        out.append((f"cables[{i}]", f"cable{'s' if len(names) > 1 else ''} {shown}: no support "
+                    "holds {} directly or through other cables, springs or bars, so a static or "
+                    "modal step has no equilibrium; support a node of it, or join it to a "
+                    "supported part".format("them" if len(names) > 1 else "it")))
     return out

@@ -145,7 +145,8 @@ def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, s
             "shape": var(("mode", "node", "axis"), shape, "1",
                           "mode shape (largest nodal displacement component = 1)"),
             "plane": label("mode", plane,
-                            "in-plane or out-of-plane (single-span cables; else unclassified)"),
+                            "in-plane or out-of-plane of the cable's plane through chord and sag "
+                            "(single-span cables; else unclassified)"),
             "symmetry": label("mode", symmetry,
                                "symmetric or antisymmetric about midspan (single-span cables)"),
         },

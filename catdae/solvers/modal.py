@@ -97,13 +97,16 @@ SYMMETRY_SHARE = 0.9  # of a shape's squares, in its symmetric or antisymmetric 
 def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str], list[str]]:
     """Label the modes of a single-span cable: in-plane/out-of-plane, symmetric/antisymmetric.
 
-    The plane is the vertical plane through the chord; a mode is out-of-plane when most of its
-    nodal motion (sum of squares over the nodes) is normal to it. Symmetry is read from the
+    The plane is the cable's own: through its chord and its sag (the plane that holds the
+    nodes' offsets from the chord best; the vertical plane through the chord in still air, tilted
+    by the swing under a wind), or the vertical plane through the chord when the cable is
+    straight. A mode is out-of-plane when most of its nodal motion (sum of squares over the
+    nodes) is normal to that plane. Symmetry is read from the
     mirror image about the cable's middle (the shape at unstrained arc length L - s against
     that at s, interpolated between nodes): "symmetric" or "antisymmetric" when that part is
     at least SYMMETRY_SHARE of the shape, else "mixed" (a scene that is not symmetric, such as
-    a mass off midspan, mixes the two). Scenes with several cables, or a vertical chord, are
-    labelled "unclassified".
+    a mass off midspan, mixes the two). Scenes with several cables, or a straight vertical
+    cable, are labelled "unclassified".
     """
     mesh = model.mesh
     n = shapes.shape[0]
@@ -111,14 +114,20 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
         return ["unclassified"] * n, ["unclassified"] * n
     order = np.concatenate([mesh.conn[:, 0], mesh.conn[-1:, 1]])  # nodes along the cable
     chord = X[order[-1]] - X[order[0]]
-    horiz = np.array([chord[0], chord[1], 0.0])
-    if np.linalg.norm(horiz) < 1e-9 * np.linalg.norm(chord):
-        return ["unclassified"] * n, ["unclassified"] * n
-    e1 = horiz / np.linalg.norm(horiz)  # along the span
-    e3 = np.array([0.0, 0.0, 1.0])
-    e2 = np.cross(e3, e1)  # normal to the cable plane
-    t_chord = chord / np.linalg.norm(chord)  # along the chord, and normal to it in the plane
-    n_chord = np.cross(e2, t_chord)
+    t_chord = chord / np.linalg.norm(chord)  # along the chord
+    rel = X[order] - X[order[0]]
+    offsets = rel - np.outer(rel @ t_chord, t_chord)  # (n_along, 3), normal to the chord
+    w, v = np.linalg.eigh(offsets.T @ offsets)
+    if np.sqrt(w[-1]) > 1e-6 * np.linalg.norm(chord):  # the sag's direction: the cable's plane
+        n_chord = v[:, -1] * np.sign(v[2, -1] or 1.0)
+        e2 = np.cross(t_chord, n_chord)  # normal to the cable's plane
+    else:  # straight: the vertical plane through the chord
+        horiz = np.array([chord[0], chord[1], 0.0])
+        if np.linalg.norm(horiz) < 1e-9 * np.linalg.norm(chord):
+            return ["unclassified"] * n, ["unclassified"] * n
+        e2 = np.cross([0.0, 0.0, 1.0], horiz / np.linalg.norm(horiz))
+    e2 = e2 / np.linalg.norm(e2)
+    n_chord = np.cross(e2, t_chord)  # normal to the chord in the plane
     s_along = mesh.s_node[order]
     s_mirror = s_along[0] + s_along[-1] - s_along
 
@@ -129,9 +138,7 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
     for i in range(n):
         u = shapes[i, order]  # (n_along, 3)
         out = u @ e2
-        a1 = u @ e1
-        a3 = u @ e3
-        in_plane = float(a1 @ a1 + a3 @ a3) >= float(out @ out)
+        in_plane = float(np.sum(u * u)) - float(out @ out) >= float(out @ out)
         plane.append("in-plane" if in_plane else "out-of-plane")
         # mirror about the chord's middle: the component along the chord changes sign, the
         # one normal to it (in the plane) keeps its sign (an inclined stay's modes too)

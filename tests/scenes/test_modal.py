@@ -684,3 +684,27 @@ def test_more_modes_than_the_model_has_are_all_given_and_said():
     ds = catdae.run(catdae.load_case(text))["modes"].ds
     assert ds.mode.size == 6
     assert "40 modes were asked for and the model has 6" in ds.attrs["note"]
+
+
+def test_labels_follow_the_plane_of_a_cable_swung_by_wind():
+    """A conductor blown 50° aside hangs in a plane tilted by atan(p / w) from the vertical:
+    its pendulum swing (the lowest mode) moves normal to that plane and was labelled
+    "in-plane" (the labels took the vertical plane through the chord). Each mode's share of
+    motion normal to the closed-form plane decides its label here."""
+    w, p = 9.81 * 1.6, 9.81 * 1.6 * math.tan(math.radians(50.0))  # N/m weight, wind across
+    text = cable_scene(B=(300.0, 0.0, 0.0), L0=303.0, EA=2e7, mass=1.6, elements=20,
+                       gravity=9.81, extra=distributed_load("c", [0.0, p, 0.0]),
+                       steps=static_step("st") + modal_step(6))
+    tree = catdae.run(catdae.load_case(text))
+    swing = float(tree["st"].ds.swing_angle.values[0])
+    assert swing == pytest.approx(50.0, abs=1e-3)  # the plane the closed form tilts (O(h²))
+    theta = math.atan2(p, w)
+    normal = np.array([0.0, math.cos(theta), math.sin(theta)])  # normal to the swung plane
+    modes = tree["modes"].ds
+    for k in range(modes.sizes["mode"]):
+        u = modes.shape.values[k]
+        share = float(np.sum((u @ normal) ** 2) / np.sum(u * u))
+        label = str(modes.plane.values[k])
+        assert label == ("out-of-plane" if share > 0.5 else "in-plane"), (k, share, label)
+        assert min(share, 1 - share) < 0.01  # each mode is clearly one or the other
+    assert str(modes.plane.values[0]) == "out-of-plane"  # the swing

@@ -11,7 +11,7 @@ import pytest
 from catdae.case import case_from_dict
 from catdae.model.connectors import Connectors
 
-from scene_toml import bar, cable_scene, damper, point_mass, spring, static_step, step
+from scene_toml import bar, cable, cable_scene, damper, point_mass, scene, spring, static_step, step
 
 
 def _toml(text):
@@ -192,6 +192,34 @@ def test_a_node_held_by_a_damper_alone_is_refused_before_any_work(tmp_path, caps
     err = capsys.readouterr().err
     assert f"{f}: dampers[0].ends: node 'F' is held by the damper alone" in err
     f.write_text(scene(damper("d", ["c.2", "F"], 5.0) + spring("k", ["c.2", "F"], 100.0)))
+    assert main(["check", str(f)]) == 0
+
+
+def test_a_part_no_support_holds_is_refused_before_any_work(tmp_path, capsys):
+    """A tester's second cable C-D touching nothing: check said valid, the static step ran
+    200 Newton iterations ("ramped up to 0 %") and the modal step said "not stable", naming
+    nothing. A part of the scene with no support has no equilibrium (a rigid drift at least):
+    refused at check (exit 2) naming its cables; held through a spring, or only in a
+    transient (a part let fall on purpose), it is valid."""
+    from catdae.cli import main
+
+    def floating(extra="", steps=None):
+        return scene(materials={"m": {"EA": 1e6, "mass": 1.0}},
+                     nodes={"A": (0, 0, 0), "B": (10, 0, 0), "C": (0, 5, 0), "D": (10, 5, 0)},
+                     cables=cable("c", ("A", "B"), length=10.2, elements=2)
+                     + cable("f", ("C", "D"), length=10.2, elements=2)
+                     + cable("g", ("D", "C"), length=10.4, elements=2),
+                     extra=extra, steps=steps or static_step("st"))
+
+    f = tmp_path / "floating.toml"
+    f.write_text(floating())
+    for args in (["check", str(f)], ["run", str(f), "-o", str(tmp_path / "o.nc")]):
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert f"{f}: cables[1]: cables 'f', 'g': no support holds them" in err, err
+    f.write_text(floating(spring("k", ["c.1", "f.1"], 1e3)))
+    assert main(["check", str(f)]) == 0
+    f.write_text(floating(steps=step("transient", "fall", duration=0.1, output_interval=0.1)))
     assert main(["check", str(f)]) == 0
 
 
