@@ -355,9 +355,9 @@ def engineering_results(step: Step, ds: xr.Dataset, case: Case,
             ds = ds.assign_attrs(temperature=_number(case.reference_temperature + temperature))
     if step.kind == "transient":
         ref = groups.get(step.jump_reference) if step.jump_reference else None
-        if ref is not None:
-            ds = ds.assign_attrs(jump_reference=step.jump_reference)
-        ds = engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float))
+        ds = ds.assign_attrs(jump_reference=step.jump_reference) if ref is not None else ds
+        ds = engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float),
+                                       start=engineering.start_tension(step, groups))
     if step.kind != "modal" and names and _thermal(case):
         ds = engineering.add_temperatures(ds, names, temperature, case.reference_temperature)
     return effective_tension(ds, case.water is not None)
