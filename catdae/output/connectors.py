@@ -33,6 +33,9 @@ def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
                                    "angle of the connector's axis (end a to end b) from the "
                                    "vertical line (0: hanging or standing straight; NaN for a "
                                    "damper)"),
+        connector_axis=var((*dims, "axis"), unit_axes(connectors, X), "1",
+                           "unit vector along the connector from end a to end b (its "
+                           "horizontal part: the side a string swings to)"),
     ).assign_coords(
         connector=label("connector", connectors.names, "connector name"),
         connector_kind=label("connector", connectors.kinds, "spring, damper or bar"),
@@ -56,6 +59,14 @@ def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarra
     mac = num / np.where(den > 0, den, 1.0)
     out[:d.shape[0]] = np.argmax(mac, axis=1) + 1
     return out
+
+
+def unit_axes(connectors, X: np.ndarray) -> np.ndarray:
+    """Each connector's unit vector from end a to end b (..., n, 3) (NaN where they meet)."""
+    d = X[..., connectors.ends[:, 1], :] - X[..., connectors.ends[:, 0], :]
+    length = np.linalg.norm(d, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(length > 0, d / length, np.nan)
 
 
 def swing_angles(connectors, X: np.ndarray) -> np.ndarray:

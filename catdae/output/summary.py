@@ -70,8 +70,9 @@ def _transient_lines(name: str, ds) -> list[str]:
 
 
 def _deg(angle: float) -> str:
-    """An angle in degrees as printed: 0 below 1e-9 deg (a still-air span's rounding)."""
-    return "0" if abs(angle) < 1e-9 else f"{angle:.6g}"
+    """An angle in degrees as printed: 0 below 1e-6 deg (the rounding of a static solve, whose
+    force residual is 1e-11 of the loads: a still-air span's 3.6e-9 deg)."""
+    return "0" if abs(angle) < 1e-6 else f"{angle:.6g}"
 
 
 def _connector_lines(ds) -> list[str]:
@@ -86,14 +87,29 @@ def _connector_lines(ds) -> list[str]:
             continue
         if "time" not in ds.connector_swing_angle.dims:
             out.append(f"    {kind} {name}: force {float(ds.connector_force.values[k]):.6g} N, "
-                       f"swing angle {_deg(float(ds.connector_swing_angle.values[k]))} deg")
+                       f"swing angle {_deg(float(ds.connector_swing_angle.values[k]))} deg"
+                       f"{_axis_text(ds, k)}")
         elif "connector_swing_angle_max" in ds:
             top = float(ds.connector_swing_angle_max.values[k])
+            when = float(ds.connector_swing_angle_max_time.values[k])
             out.append(f"    {kind} {name}: swing angle "
                        f"{_deg(float(ds.connector_swing_angle_min.values[k]))} to {_deg(top)} "
-                       f"deg, largest at t = "
-                       f"{float(ds.connector_swing_angle_max_time.values[k]):.6g} s")
+                       f"deg, largest at t = {when:.6g} s{_axis_text(ds, k, when)}")
     return out
+
+
+def _axis_text(ds, k: int, when: float | None = None) -> str:
+    """Where connector k's end b is from its end a (its unit axis), at ``when`` in a transient:
+    the side a string swings to, which the angle alone does not say."""
+    if "connector_axis" not in ds:
+        return ""
+    a = ds.connector_axis.isel(connector=k)
+    if when is not None:
+        a = a.sel(time=when, method="nearest")
+    v = np.asarray(a.values, float)
+    v = np.where(np.abs(v) < 5e-5, 0.0, v)  # no "-0.0000"
+    return "" if not np.isfinite(v).all() else (
+        f" (axis a to b {', '.join(f'{x:+.4f}' for x in v)})")
 
 
 def _temperatures(ds) -> str:

@@ -66,11 +66,18 @@ def test_static_swing_of_a_string_is_atan_of_lateral_over_vertical_load(turned, 
     assert float(angle.sel(connector="soft")) == pytest.approx(
         math.degrees(math.atan(P / W)), rel=1e-9)
     assert np.isnan(float(angle.sel(connector="d")))
+    # the side: the clamp swings toward the lateral load (+y upright), which the angle alone
+    # does not say: the axis from the cross-arm down to the clamp, in the case's axes
+    axis = ds.connector_axis.sel(connector="string").values
+    expect = _turn((0.0, math.sin(math.radians(bar_theta)), -math.cos(math.radians(bar_theta))),
+                   turned)
+    np.testing.assert_allclose(axis, expect, atol=1e-9)
     from catdae.output.summary import summary
 
     text = summary(tree)
     assert (f"bar string: force {float(ds.connector_force.sel(connector='string')):.6g} N, "
-            f"swing angle {bar_theta:.6g} deg") in text, text
+            f"swing angle {bar_theta:.6g} deg (axis a to b "
+            f"{', '.join(f'{x:+.4f}' for x in expect)})") in text, text
 
 
 def pendulum(theta0_deg: float, mass: float = 100.0):
