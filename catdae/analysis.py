@@ -254,7 +254,7 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
         model = Model(trial, mesh.heated(trial, temperature), removed)
         X, h = (mesh.X0, None) if warm is None else (warm[2].X, warm[2].state.h)
         sol = solve_static(model, X, h, t=state.t, load_steps=step.load_steps)
-        return (mesh, model, sol), model.cable_summary(sol.X, sol.state)
+        return (mesh, model, sol), formfind.summary_of(trial, model, sol)
 
     found, (mesh, model, sol) = formfind.solve(case, evaluate)
     return found, mesh, model, _static_result(model, state, sol)

@@ -281,6 +281,17 @@ class Elements:
         """x(s) - x_i for s (n, q) or (q,), returns (n, q, 3) m."""
         return self._partial(h, s, False)[0]
 
+    def position_in(self, e: int, h_e, s: float) -> np.ndarray:
+        """x(s) - x_i of element ``e`` alone for its end force ``h_e`` (3,), m: the same kernel
+        on that element's data, for a search along one element (not every element's point)."""
+        x = np.empty((1, 1, 3))
+        h1 = np.array(h_e, float).reshape(1, 3)
+        h1.flags.writeable = False  # as every other call passes it (one compiled signature)
+        partial_batch(h1, self.L0[e:e + 1],
+                      self.EA[e:e + 1], self.w[e:e + 1], self._ptr[e:e + 2], self._ls,
+                      self._lf, np.full((1, 1), float(s)), x, np.empty((1, 1, 6)), False)
+        return x[0, 0]
+
     def partial_flexibility(self, h, s) -> np.ndarray:
         """G(s) = ∂x(s)/∂h, (n, q, 3, 3) m/N (§6)."""
         return sym_from_upper(self._partial(h, s, True)[1])

@@ -267,25 +267,31 @@ class Model(MassMatrices):
         """Tension at ends i and j of every element, (n_elem, 2) N."""
         return self.elements.end_tensions(state.h)
 
-    def cable_summary(self, X: np.ndarray, state: ElementState) -> dict[str, np.ndarray]:
+    def cable_summary(self, X: np.ndarray, state: ElementState,
+                      sag: bool = True) -> dict[str, np.ndarray]:
         """Per cable: tension at its two ends, horizontal tension at its first end, sag, and
         unstrained length (at the reference temperature).
 
         Sag is the largest vertical distance from the chord to the cable (sampled on the exact
         curve of every element); for a vertical chord, the largest distance from the chord.
+        Without ``sag`` it is NaN (its search along the curve costs most: form-finding to
+        tensions asks for the rest hundreds of times).
         """
         mesh = self.mesh
         nc = len(mesh.cable_names)
         end_t = np.zeros((nc, 2))
         h_t = np.zeros(nc)
-        sag = np.zeros(nc)
+        sags = np.zeros(nc) if sag else np.full(nc, np.nan)
         tens = self.tensions(state)
         s = np.linspace(0.0, 1.0, 17)[None, :] * mesh.L0[:, None]  # (n_elem, 17)
-        pts = X[mesh.conn[:, 0]][:, None, :] + self.elements.position(state.h, s)
+        pts = (X[mesh.conn[:, 0]][:, None, :] + self.elements.position(state.h, s)) if sag \
+            else None
         for ci in range(nc):
             els = np.flatnonzero(mesh.cable_of_element == ci)
             end_t[ci] = tens[els[0], 0], tens[els[-1], 1]
             h_t[ci] = float(np.hypot(*state.h[els[0], :2]))
+            if not sag:
+                continue
             a = X[mesh.conn[els[0], 0]]
             b = X[mesh.conn[els[-1], 1]]
             p = pts[els].reshape(-1, 3) - a
@@ -315,15 +321,13 @@ class Model(MassMatrices):
                 xi = X[mesh.conn[e, 0]] - a
 
                 def neg(sv, e=e, xi=xi, dist=dist):
-                    q = np.zeros((mesh.n_elements, 1))
-                    q[e, 0] = sv
-                    return -float(dist(xi + self.elements.position(state.h, q)[e, 0]))
+                    return -float(dist(xi + self.elements.position_in(e, state.h[e], sv)))
 
                 best = minimize_bounded(neg, lo, hi, xatol=1e-10 * mesh.L0[e])
                 best_sag = max(best_sag, -float(best[1]))
             # round-off of a straight (weightless, unloaded) line is no sag
-            sag[ci] = best_sag if best_sag > 1e-12 * float(np.linalg.norm(c)) else 0.0
+            sags[ci] = best_sag if best_sag > 1e-12 * float(np.linalg.norm(c)) else 0.0
         unstrained = np.bincount(mesh.cable_of_element, weights=mesh.L0 / mesh.thermal,
                                  minlength=nc)
-        return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sag,
+        return {"end_tension": end_t, "horizontal_tension": h_t, "sag": sags,
                 "unstrained_length": unstrained}

@@ -14,11 +14,13 @@ shared free node) are solved together.
 
 Method: Newton on L around the static solve, with the Jacobian ∂r/∂L by forward differences
 (one warm-started static solve per form-found cable, each a few Newton iterations from the
-base equilibrium), and a backtracking line search on |r|. This reuses the static solver as it
+base equilibrium), kept up to date between them by Broyden's rank-one update from each step
+taken (differences again when a step leads nowhere), and a
+backtracking line search on |r|. This reuses the static solver as it
 is (load stepping, line search, slack elements) instead of adding the lengths to its unknowns:
 an augmented system would need ∂(element forces)/∂L0 and ∂(sag)/∂X from the kernel, which it
-does not provide. The cost is (n + 1) static solves per iteration for n form-found cables;
-Newton converges in a handful of iterations from the starting lengths below.
+does not provide. The cost is n static solves per Jacobian for n form-found cables, and one
+or a few per iteration.
 
 Starting lengths, and bad targets: each cable alone, hanging between its end nodes under its
 own weight (at the first static step's temperature), is one exact catenary element; its q(L0)
@@ -46,7 +48,7 @@ from catdae.element.elements import SLACK, Elements
 from catdae.errors import CaseError, ConvergenceError
 
 TOL = 1e-9  # relative: |q - target| <= TOL |target|
-MAX_ITER = 40
+MAX_ITER = 100  # Broyden steps are one static solve each
 _UNITS = {"horizontal_tension": "N", "tension": "N", "sag": "m"}
 
 
@@ -188,6 +190,13 @@ def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
                   f"(at most {qmax:.6g} {unit})")
 
 
+def summary_of(case: Case, model, sol) -> dict:
+    """What :func:`measure` needs of a solved trial (Model.cable_summary): the sags only where
+    a target is a sag (their search along the curve was 80 % of a net's form-finding)."""
+    sag = any(case.cables[i].form.kind == "sag" for i in pending(case))
+    return model.cable_summary(sol.X, sol.state, sag=sag)
+
+
 def measure(case: Case, summary: dict) -> np.ndarray:
     """The quantity each pending cable's form sets, from Model.cable_summary, (n_pending,)."""
     out = []
@@ -229,10 +238,7 @@ def solve(case: Case, evaluate) -> tuple[Case, object]:
     L = np.array([case.cables[i].length for i in idx], float)
     L_min = np.array([np.linalg.norm(np.subtract(*(case.nodes[e] for e in case.cables[i].ends)))
                       for i in idx]) / (1.0 + MAX_STRAIN)
-    r, base = resid(L, None)
-    for _ in range(MAX_ITER):
-        if np.abs(r).max() <= TOL:
-            return with_lengths(L), base
+    def jacobian(L, r, base):
         J = np.empty((len(L), len(L)))
         for k in range(len(L)):
             dL = 1e-7 * L[k]
@@ -245,6 +251,15 @@ def solve(case: Case, evaluate) -> tuple[Case, object]:
                 rp, _ = resid(Lp, base)
                 dL = -dL
             J[:, k] = (rp - r) / dL
+        return J
+
+    r, base = resid(L, None)
+    J, fresh = None, False
+    for _ in range(MAX_ITER):
+        if np.abs(r).max() <= TOL:
+            return with_lengths(L), base
+        if J is None:
+            J, fresh = jacobian(L, r, base), True
         step_L = np.linalg.lstsq(J, -r, rcond=None)[0]
         # at most +-50 % of a length per iteration
         big = np.abs(step_L) / (0.5 * L)
@@ -260,11 +275,19 @@ def solve(case: Case, evaluate) -> tuple[Case, object]:
                     rn = None
                 if rn is not None and np.all(np.isfinite(rn)) and (
                         np.linalg.norm(rn) < (1.0 - 1e-4 * alpha) * np.linalg.norm(r)):
-                    L, r, base = Ln, rn, res
                     break
             alpha *= 0.5
         else:
-            break
+            if fresh:
+                break
+            J = None  # the updated Jacobian led nowhere: differences again
+            continue
+        # Broyden's update of J with the step taken (no static solve), differences again
+        # only where it leads nowhere: n static solves per Jacobian made a 60-cable net's
+        # form-finding take a minute
+        s_L = Ln - L
+        J = J + np.outer(rn - r - J @ s_L, s_L) / (s_L @ s_L)
+        L, r, base, fresh = Ln, rn, res, False
     if np.abs(r).max() <= TOL:
         return with_lengths(L), base
     worst = np.argsort(-np.abs(r))
