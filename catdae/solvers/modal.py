@@ -94,6 +94,27 @@ def _reciprocal(k: np.ndarray, m: np.ndarray, n_modes: int) -> tuple[np.ndarray,
 SYMMETRY_SHARE = 0.9  # of a shape's squares, in its symmetric or antisymmetric part, to say so
 
 
+def _cable_plane(P: np.ndarray):
+    """(along the chord, normal to it in the cable's plane, normal to the plane) of the nodes
+    P (n_along, 3) in order: the plane through the chord that holds their offsets from it
+    best (the sag's direction), or the vertical plane through the chord of a straight cable;
+    None for a straight vertical one."""
+    chord = P[-1] - P[0]
+    t_chord = chord / np.linalg.norm(chord)
+    rel = P - P[0]
+    offsets = rel - np.outer(rel @ t_chord, t_chord)  # normal to the chord
+    w, v = np.linalg.eigh(offsets.T @ offsets)
+    if np.sqrt(w[-1]) > 1e-6 * np.linalg.norm(chord):  # the sag's direction: the cable's plane
+        e2 = np.cross(t_chord, v[:, -1])
+    else:
+        horiz = np.array([chord[0], chord[1], 0.0])
+        if np.linalg.norm(horiz) < 1e-9 * np.linalg.norm(chord):
+            return None
+        e2 = np.cross([0.0, 0.0, 1.0], horiz)
+    e2 = e2 / np.linalg.norm(e2)
+    return t_chord, np.cross(e2, t_chord), e2
+
+
 def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str], list[str]]:
     """Label the modes of a single-span cable: in-plane/out-of-plane, symmetric/antisymmetric.
 
@@ -113,21 +134,10 @@ def classify(model: Model, X: np.ndarray, shapes: np.ndarray) -> tuple[list[str]
     if len(mesh.cable_names) != 1:
         return ["unclassified"] * n, ["unclassified"] * n
     order = np.concatenate([mesh.conn[:, 0], mesh.conn[-1:, 1]])  # nodes along the cable
-    chord = X[order[-1]] - X[order[0]]
-    t_chord = chord / np.linalg.norm(chord)  # along the chord
-    rel = X[order] - X[order[0]]
-    offsets = rel - np.outer(rel @ t_chord, t_chord)  # (n_along, 3), normal to the chord
-    w, v = np.linalg.eigh(offsets.T @ offsets)
-    if np.sqrt(w[-1]) > 1e-6 * np.linalg.norm(chord):  # the sag's direction: the cable's plane
-        n_chord = v[:, -1] * np.sign(v[2, -1] or 1.0)
-        e2 = np.cross(t_chord, n_chord)  # normal to the cable's plane
-    else:  # straight: the vertical plane through the chord
-        horiz = np.array([chord[0], chord[1], 0.0])
-        if np.linalg.norm(horiz) < 1e-9 * np.linalg.norm(chord):
-            return ["unclassified"] * n, ["unclassified"] * n
-        e2 = np.cross([0.0, 0.0, 1.0], horiz / np.linalg.norm(horiz))
-    e2 = e2 / np.linalg.norm(e2)
-    n_chord = np.cross(e2, t_chord)  # normal to the chord in the plane
+    frame = _cable_plane(X[order])
+    if frame is None:
+        return ["unclassified"] * n, ["unclassified"] * n
+    t_chord, n_chord, e2 = frame
     s_along = mesh.s_node[order]
     s_mirror = s_along[0] + s_along[-1] - s_along
 
