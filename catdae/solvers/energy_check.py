@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 GAIN_LIMIT = 1e-2  # of the energy moved, or 10 rtol if that is larger
+LOSS_LIMIT = 0.1  # of the energy moved, lost where nothing dissipates: worth a word
 JUMP_LIMIT = 1e-3  # m/s: a larger support velocity jump does impulsive work the outputs miss
 
 
@@ -39,10 +40,11 @@ def support_work(model, times: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, n
     return W, U
 
 
-def energy_gain(model, prob, rec, n_valid: int):
-    """(gain J, energy moved J, first time s the gain passed the limit, its limit J), or None
-    when the balance cannot be closed at the outputs (loads that vary in time, support velocity
-    jumps, fewer than two outputs) or no energy was gained beyond the limit."""
+def _balance(model, prob, rec, n_valid: int):
+    """(output times, the energy's change less the work done on the line, J, the allowance
+    for the supports' work between outputs, J, the energy moved, J), or None when the balance
+    cannot be closed at the outputs (loads that vary in time, support velocity jumps, fewer
+    than two outputs)."""
     if n_valid < 2 or rec is None:
         return None
     ld = model.loading
@@ -58,17 +60,52 @@ def energy_gain(model, prob, rec, n_valid: int):
     W = rec.W[:n_valid] if rec.work is not None else np.zeros(n_valid)
     W = np.nan_to_num(W)
     Ws, Us = support_work(model, t, rec.R[:n_valid])
-    gap = dE - W - Ws - Us  # a gain the supports' work between outputs could explain is none
     # the energy moved in or out, and the largest kinetic and strain energies: the scale of
     # the state's own energy, whose integration error is of order rtol of it
     moved = float(np.abs(dE).max() + np.abs(W).max() + np.abs(Ws).max()
                   + np.abs(rec.E[:n_valid, 0]).max() + np.abs(rec.E[:n_valid, 1]).max())
+    return t, dE - W - Ws, Us, moved
+
+
+def energy_gain(model, prob, rec, n_valid: int):
+    """(gain J, energy moved J, first time s the gain passed the limit, its limit J), or None
+    when the balance cannot be closed at the outputs (:func:`_balance`) or no energy was
+    gained beyond the limit."""
+    found = _balance(model, prob, rec, n_valid)
+    if found is None:
+        return None
+    t, balance, Us, moved = found
+    gap = balance - Us  # a gain the supports' work between outputs could explain is none
     limit = max(GAIN_LIMIT, 10.0 * float(prob.step.rtol)) * moved
     gain = float(gap.max())
     if not moved > 0.0 or gain <= limit:
         return None
     first = float(t[np.argmax(gap > limit)])
     return gain, moved, first, limit
+
+
+def loss_note(model, prob, rec, n_valid: int) -> str:
+    """A word when a scene with nothing to take energy out (no damping of any kind, no fluid,
+    seabed or damper) lost more than LOSS_LIMIT of the energy moved: the BDF's own damping at
+    the step's tolerances (an undamped pendulum at rtol 1e-2 lost 83 % of its energy and half
+    its swing, reported "completed" with no word)."""
+    cn = model.connectors
+    if (prob.damping.damped or prob.axial is not None or model.fluid is not None
+            or getattr(prob, "seabed", None) is not None
+            or (cn is not None and np.any(cn.coefficient > 0))):
+        return ""
+    found = _balance(model, prob, rec, n_valid)
+    if found is None:
+        return ""
+    t, balance, Us, moved = found
+    loss = -float((balance + Us).min())
+    if not moved > 0.0 or loss <= LOSS_LIMIT * moved:
+        return ""
+    return (f"the run lost {loss:.3g} J ({loss / moved:.0%} of the {moved:.3g} J moved) with "
+            "nothing in the scene to take energy out (no damping, fluid, seabed or damper): "
+            "the integrator's own damping at these tolerances (rtol "
+            f"{float(prob.step.rtol):g}); tighten rtol and atol where the motion's amplitude "
+            "matters (docs/theory.md §13.6)")
 
 
 def gain_note(model, prob, rec, n_valid: int) -> str:
