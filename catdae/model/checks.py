@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from catdae.case import Case
+from catdae.case import AXES, Case
 from catdae.errors import CaseError
 from catdae.model import formfind
 from catdae.model.assembly import Model
@@ -26,6 +26,12 @@ def check_steps(case: Case, mesh) -> None:
                          "(form-finding) and cannot be swept; sweep a later step"))
     problems += _damper_only_nodes(case, mesh)
     problems += _unheld_parts(case, mesh)
+    fixed = {n for n, axes in case.supports.items() if len(axes) == len(AXES)}
+    if all(n in fixed for n in mesh.node_names):  # nothing can move: no modes, no motion
+        problems += [(f"steps[{i}]", f"{s.kind} step '{s.name}': the model has no free degree "
+                      "of freedom (every node is a fully fixed support; a cable of one element "
+                      "between two supports has no node of its own): give the cables 2 or more "
+                      "elements") for i, s in enumerate(case.steps) if s.kind != "static"]
     absent = {x.name for x in (*case.point_masses, *case.loads, *case.distributed_loads)
               if not x.active}
     for i, step in enumerate(case.steps):

@@ -591,11 +591,19 @@ def _no_free_dof_run(tmp_path, capsys, steps):
     return None
 
 
-def test_modal_step_without_free_dofs_is_a_clean_failure(tmp_path, capsys):
-    assert _no_free_dof_run(tmp_path, capsys, modal(2)) is None
-    tree = catdae.read_results(tmp_path / "one.nc")
-    assert "no free degree of freedom" in tree.attrs["status"]
-    assert_sound(tree)
+def test_modal_step_without_free_dofs_is_refused_before_any_work(tmp_path, capsys):
+    """Knowable from the case alone (tester t63: the static step ran, then exit 1 naming no
+    field): exit 2 at check and at run, naming the step, and nothing written."""
+    case = tmp_path / "one.toml"
+    case.write_text(scene(B=(10.0, 0, 0), L0=11.0, EA=1e6, mass=1.0, elements=1,
+                          steps=STATIC + modal(2) + transient(0.1, 0.01)))
+    for args in (["check", str(case)], ["run", str(case), "-o", str(tmp_path / "one.nc")]):
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        for i, kind in ((1, "modal"), (2, "transient")):
+            assert f"steps[{i}]: {kind} step" in err and "no free degree of freedom" in err
+    assert not (tmp_path / "one.nc").exists()
+    assert main(["check", str(case), "--elements", "2"]) == 0  # a node of its own to move
 
 
 def test_transient_step_without_free_dofs(tmp_path, capsys):
