@@ -318,8 +318,7 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
             "loads and their units")
     if model.fluid is not None:
         ds = results.with_note(ds, plausibility_note(model.case, waves=False))
-    return engineering.add_static(ds, span_quantities(model, sol.X, sol.state),
-                                  engineering.rated_strengths(model.case, model.mesh.cable_names))
+    return engineering.add_static(ds, span_quantities(model, sol.X, sol.state), model.case)
 
 
 def _partial(step: Step, ds: xr.Dataset, case: Case, groups, temperature, on_group):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from catdae.case import Case
-from catdae.case.names import mesh_node
+from catdae.case.names import mesh_node, split_mesh_node
 from catdae.element.elements import SLACK, Elements, PointLoads
 from catdae.errors import CaseError
 from catdae.model.fluid import element_weights, line_weight
@@ -242,13 +242,17 @@ def _catenary_points(case, cable, a, b, ea, w, s_nodes) -> np.ndarray:
     st = el.solve((b - a)[None])
     if st.converged[0] and st.status[0] != SLACK:
         return a + el.position(st.h, s_nodes[None])[0]
-    items = []
-    for pm in case.point_masses:
-        if pm.cable == cable.name:
-            items.append((pm.s, (0.0, 0.0, -pm.mass * case.gravity)))
-    for ld in case.loads:
-        if ld.cable == cable.name:
-            items.append((ld.s, tuple(ld.force)))
+    def s_of(item):  # along this cable: by cable and s, or at one of its mesh nodes
+        if item.cable == cable.name:
+            return item.s
+        node = split_mesh_node(item.node or "")
+        if node is not None and node[0] == cable.name and node[1].isdigit():
+            return cable.length * int(node[1]) / int(cable.elements)
+        return None
+
+    items = [(s_of(pm), (0.0, 0.0, -pm.mass * case.gravity)) for pm in case.point_masses]
+    items += [(s_of(ld), tuple(ld.force)) for ld in case.loads]
+    items = [(s, f) for s, f in items if s is not None]
     if items:
         el = Elements([cable.length], [ea], [w], PointLoads.from_lists([items]))
         st = el.solve((b - a)[None])

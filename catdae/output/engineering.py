@@ -18,6 +18,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from catdae._xr import xr
+from catdae.case.build_cables import MAX_STRAIN
 from catdae.case.frame import gravity_rotation
 from catdae.output.end_peaks import with_end_note
 from catdae.output.results import with_note
@@ -55,10 +56,10 @@ def rated_strengths(case, cable_names) -> np.ndarray:
     return np.array(out)
 
 
-def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
-               rated: np.ndarray) -> xr.Dataset:
+def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray], case) -> xr.Dataset:
     """The static group with the span quantities (per ``cable``) and the largest tension as a
     percentage of the rated strength."""
+    rated = rated_strengths(case, [str(c) for c in ds.cable.values])
     data = {}
     for key, (units, long_name) in _SPAN.items():
         source = "tension_max" if key == "tension_max_along_cable" else key
@@ -72,7 +73,27 @@ def add_static(ds: xr.Dataset, quantities: dict[str, np.ndarray],
         data["clearance_s"] = _cable_var(quantities["clearance_s"], "m",
                                          "unstrained arc length where the clearance is least")
     out = ds.assign(data)
-    return with_note(out, _limit_note(out, data))
+    return with_note(out, "; ".join(n for n in (_limit_note(out, data), strain_note(out, case))
+                                    if n))
+
+
+def strain_note(ds: xr.Dataset, case) -> str:
+    """Cables whose largest tension passed MAX_STRAIN of their EA: a strain beyond the range
+    the model accepts (a linear elastic material; a case that needs more is refused when it is
+    read), reached in a run (tester t63: a support pulled 200 m, "completed" at 197 %)."""
+    var = ds.get("tension_max", ds.get("tension"))
+    if var is None or "element_cable" not in ds.coords or var.size == 0:
+        return ""
+    top = np.asarray(var.max("time").values if "time" in var.dims else var.values, float)
+    said = []
+    for name in dict.fromkeys(str(c) for c in ds.element_cable.values):
+        t, ea = float(np.nanmax(top[ds.element_cable.values == name])), case.material_of(name).EA
+        if t > MAX_STRAIN * ea:
+            said.append(f"cable {name!r} reached a strain of {100 * t / ea:.3g} % (tension "
+                        f"{t:.4g} N), "
+                        f"beyond the {MAX_STRAIN:.0%} this model accepts (a linear elastic "
+                        "material): read its tensions and motion as outside the model's range")
+    return "; ".join(said)
 
 
 def _limit_note(ds: xr.Dataset, data: dict) -> str:
@@ -220,7 +241,7 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
         out = out.assign(jump(ds, reference, cables, up))
     if getattr(case, "ground", None) is not None:
         out = out.assign(clearance_over_time(ds, case.ground, cables, up))
-    return with_end_note(out)
+    return with_end_note(with_note(out, strain_note(out, case)))
 
 
 def clearance_over_time(ds: xr.Dataset, ground, cables: list[str],

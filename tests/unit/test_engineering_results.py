@@ -182,3 +182,31 @@ def test_a_load_shed_at_once_does_not_lower_the_tension_envelope_below_its_start
         assert "starts from" in ds[name].attrs["long_name"]
     plain = catdae.run(catdae.load_case(case()))["kicked"].ds  # no add, no remove
     assert "starts from" not in plain.tension_max.attrs["long_name"]
+
+
+def test_a_strain_past_the_models_range_is_noted():
+    """A weightless 10 m line (EA 1e4 N) pulled down at midspan by 2e4 N stretches by far more
+    than the 50 % the model accepts (a case that needs more is refused when read; loads reach
+    it in a run, and a run said nothing: tester t63's pulled support at 197 %). The strain in
+    the note is the closed form's: two straight halves, 2 T sin θ = P, T = EA (l / (L0/2) - 1)
+    with l cos θ = 5 m."""
+    from scipy.optimize import brentq
+
+    ea, p_load, half = 1.0e4, 2.0e4, 5.0
+
+    def unbalance(theta):
+        length = half / np.cos(theta)
+        return 2.0 * ea * (length / 5.05 - 1.0) * np.sin(theta) - p_load
+
+    theta = brentq(unbalance, 1e-3, 1.5)
+    strain = half / np.cos(theta) / 5.05 - 1.0
+    assert strain > 0.5
+    text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=ea, mass=1.0, weight=0.0, elements=2,
+                       extra=load("pull", [0.0, 0.0, -p_load], node="c.1"),
+                       steps=static_step("pulled"))
+    note = catdae.run(catdae.load_case(text))["pulled"].ds.attrs.get("note", "")
+    assert f"cable 'c' reached a strain of {100 * strain:.3g} %" in note, note
+    calm = cable_scene(B=(10.0, 0.0, 0.0), L0=10.1, EA=ea, mass=1.0, weight=0.0, elements=2,
+                       extra=load("pull", [0.0, 0.0, -100.0], node="c.1"),
+                       steps=static_step("pulled"))
+    assert "strain" not in catdae.run(catdae.load_case(calm))["pulled"].ds.attrs.get("note", "")
