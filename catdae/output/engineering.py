@@ -22,6 +22,7 @@ from catdae.case.build_cables import MAX_STRAIN
 from catdae.case.frame import gravity_rotation
 from catdae.output.end_peaks import with_end_note
 from catdae.output.results import with_note
+from catdae.output.swing import swing_over_time
 
 _SPAN = {  # name: (units, long_name)
     "horizontal_tension_along_chord": (
@@ -237,6 +238,7 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
             "percentage of the material's rated_strength")
     out = ds.assign_coords(cable=xr.Variable("cable", np.array(cables, dtype=object),
                                              {"long_name": "cable name"})).assign(data)
+    out = out.assign(swing_over_time(ds, cables, up))
     if reference is not None:
         out = out.assign(jump(ds, reference, cables, up))
     if getattr(case, "ground", None) is not None:

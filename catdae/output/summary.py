@@ -149,6 +149,9 @@ def _mode_lines(name: str, ds) -> list[str]:
     return out
 
 
+SWING_SAID = 1.0  # degrees: a transient's largest swing angle is printed from this up
+
+
 def _jump_lines(ds) -> list[str]:
     """Per cable of a transient: its largest rise above the jump_reference step, the largest
     tension as a percentage of the rated strength (catdae.output.engineering)."""
@@ -162,6 +165,9 @@ def _jump_lines(ds) -> list[str]:
                          + (" (at the step's end: may still be rising)" if at_end(when, ds)
                             else "") + f", s = {float(ds.jump_s.values[k]):.6g} m")
         parts += _rated(ds, k)
+        if "swing_angle_max" in ds and float(ds.swing_angle_max.values[k]) >= SWING_SAID:
+            parts.append(f"largest swing angle {_deg(float(ds.swing_angle_max.values[k]))} "
+                         f"deg at t = {float(ds.swing_angle_max_time.values[k]):.6g} s")
         if "clearance_time" in ds:
             parts.append(f"least clearance {float(ds.clearance.values[k]):.6g} m at t = "
                          f"{float(ds.clearance_time.values[k]):.6g} s")

@@ -210,3 +210,33 @@ def test_a_strain_past_the_models_range_is_noted():
                        extra=load("pull", [0.0, 0.0, -100.0], node="c.1"),
                        steps=static_step("pulled"))
     assert "strain" not in catdae.run(catdae.load_case(calm))["pulled"].ds.attrs.get("note", "")
+
+
+def test_the_swing_angle_over_a_transient_follows_a_slow_wind():
+    """A level span (100 m, 10 elements: a node at midspan) under a wind across it that
+    ramps up over 20 s, well past the span's swing period (about 4 s), with damping: it swings
+    quasi-statically from 0 to atan(p / w) = 30°, the closed form of a uniform load across a
+    level span; the envelope holds the largest angle and its time (transient groups had no
+    swing angle at all: tester t62 dug a gust's blowout out of displacement_max)."""
+    from scene_toml import distributed_load
+
+    w = 9.81 * 1.5
+    p = w * np.tan(np.radians(30.0))
+    text = cable_scene(B=(100.0, 0.0, 0.0), L0=100.5, EA=2.0e7, mass=1.5, elements=10,
+                       gravity=9.81,
+                       extra=distributed_load("c", [0.0, p, 0.0], name="wind",
+                                              time={"kind": "ramp", "duration": 20.0}),
+                       steps=step("transient", "gust", duration=40.0, output_interval=0.1,
+                                  damping={"kind": "rayleigh", "alpha": 1.0, "beta": 0.0}))
+    ds = catdae.run(catdae.load_case(text))["gust"].ds
+    angle = ds.swing_angle.sel(cable="c").values
+    assert ds.swing_angle.attrs["units"] == "degree"
+    assert angle[0] == pytest.approx(0.0, abs=1e-6)
+    assert angle[-1] == pytest.approx(30.0, abs=0.05)
+    k = int(np.nanargmax(angle))
+    assert float(ds.swing_angle_max.sel(cable="c")) == angle[k]
+    assert float(ds.swing_angle_max_time.sel(cable="c")) == float(ds.time[k])
+    # halfway up the ramp: atan(p/2 / w), less the damping's lag (alpha / ω² ≈ 0.45 s of a
+    # ramp of 1.5° per second)
+    half = np.flatnonzero(ds.time.values >= 10.0)[0]
+    assert angle[half] == pytest.approx(np.degrees(np.arctan(0.5 * p / w)) - 0.7, abs=0.3)
