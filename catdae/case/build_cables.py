@@ -63,8 +63,13 @@ class CablesPass:
                 ok = False
             for j, end in enumerate(c.ends):
                 if end not in self.node_names:
-                    self.problem(where + ("ends", j),
-                                 unknown_word(end, "node", sorted(self.node_names)))
+                    mesh = split_mesh_node(end)
+                    self.problem(where + ("ends", j), (
+                        f"{end!r} is a mesh node of cable {mesh[0]!r}: a cable ends at a node "
+                        f"of [nodes] (split cable {mesh[0]!r} at a node there, or join the two "
+                        "with a spring or a bar, which may end at mesh nodes)")
+                        if mesh is not None and mesh[0] in self.cable_names
+                        else unknown_word(end, "node", sorted(self.node_names)))
                     ok = False
             if c.material not in materials:
                 if c.material not in self.material_names:

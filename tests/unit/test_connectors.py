@@ -268,3 +268,22 @@ def test_a_misspelt_connector_end_is_the_only_message(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"{f}: springs[0].ends[1]: unknown node 'mm'; did you mean 'm'?" in err, err
     assert "nothing" not in err, err
+
+
+def test_a_cable_ending_at_another_cables_mesh_node_is_told_how_to_join_them(tmp_path, capsys):
+    """A hanger ending at 'c.2' was told "unknown node 'c.2'; expected one of: 'A', 'B', 'C'"
+    (tester t64), though 'c.2' is a real node of the mesh: it is told that cables end at
+    [nodes] and that springs and bars may join mesh nodes."""
+    from catdae.cli import main
+
+    f = tmp_path / "hanger.toml"
+    f.write_text(scene(materials={"m": {"EA": 1e6, "mass": 1.0}},
+                       nodes={"A": (0, 0, 0), "B": (10, 0, 0), "C": (5, 0, -5)},
+                       supports=("A", "B", "C"),
+                       cables=cable("c", ("A", "B"), length=10.2, elements=4)
+                       + cable("h", ("c.2", "C"), length=4.0, elements=2),
+                       steps=static_step("st")))
+    assert main(["check", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert (f"{f}: cables[1].ends[0]: 'c.2' is a mesh node of cable 'c': a cable ends at a "
+            "node of [nodes]") in err, err
