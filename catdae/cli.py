@@ -221,11 +221,20 @@ def _plot(args) -> int:
         return 2
     for f in files:
         say(str(f))
+    _say_incomplete(tree, args.results, "the figures show")
     if not files:
         print(f"catdae: {args.results}: no figure to make: the steps chosen make none of "
               f"{', '.join(args.what or WHAT)}", file=sys.stderr)
         return 2
     return 0
+
+
+def _say_incomplete(tree, path, what: str) -> None:
+    """A run that failed or was interrupted: say so beside the files made from it."""
+    status = str(tree.attrs.get("status", "completed"))
+    if status != "completed":
+        print(f"catdae: {path}: note: the run did not complete ({status}); {what} what it "
+              "computed until then", file=sys.stderr)
 
 
 def _export(args) -> int:
@@ -245,6 +254,7 @@ def _export(args) -> int:
         return 2
     for f in files:
         say(f"ParaView time series written to {f}")
+    _say_incomplete(tree, args.results, "the series hold")
     if not files:
         print(f"catdae: {args.results}: nothing to export: no static or transient step",
               file=sys.stderr)

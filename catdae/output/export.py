@@ -156,9 +156,12 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str, case=None) 
                for k, t in enumerate(times) for p, fs in enumerate(parts)]
     _drop_stale(sub, name, {f for fs in parts for f in fs})
     pvd = folder / f"{name}.pvd"
+    status = str(ds.attrs.get("status", "completed"))
+    said = ("" if status == "completed" else  # a comment may not hold "--"
+            f"  <!-- step not completed: {status.replace('--', '- -')} -->\n")
     with deferred():
         pvd.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
-                       "  <Collection>\n" + "\n".join(entries)
+                       + said + "  <Collection>\n" + "\n".join(entries)
                        + "\n  </Collection>\n</VTKFile>\n")
     return pvd
 

@@ -365,6 +365,9 @@ def write_all(tree: xr.DataTree, folder: str | os.PathLike, steps=None, what=Non
             for w in (w for w in wanted if w in can):
                 path = folder / f"{name}-{w}.png"
                 fig = _figure(w, ds, node, times)
+                if (status := str(ds.attrs.get("status", "completed"))) != "completed":
+                    fig.text(0.005, 0.005, f"step not completed: {status}"[:140], fontsize=7,
+                             color="firebrick")  # the figure shows what was computed
                 with deferred():  # a signal waits until the file is complete
                     fig.savefig(path, dpi=120)
                 written.append(path)

@@ -22,8 +22,12 @@ def mark_peaks(ax, ds: xr.Dataset, var: str, node: str, axis: str) -> None:
         if not (np.isfinite(v) and np.isfinite(t)):
             continue
         ax.plot([t], [v], marker, color="k", gid=f"{node}|{axis}|{how}")
+        # inside the axes: to the left of a peak in the later half, room above and below
+        late = "time" in ds.coords and t > 0.5 * float(ds.time[0] + ds.time[-1])
         ax.annotate(f"{v:.4g} at {t:.4g} s", (t, v), textcoords="offset points",
-                    xytext=(4, 4 if how == "max" else -10), fontsize="x-small")
+                    xytext=(-4 if late else 4, 4 if how == "max" else -10),
+                    ha="right" if late else "left", fontsize="x-small")
+        ax.margins(y=0.12)
 
 
 def supports(ds: xr.Dataset) -> list[str]:

@@ -187,3 +187,41 @@ def test_damped_modes_are_drawn_as_the_damped_modes_they_are_titled_with():
         assert (f"damping ratio {zeta:.3g}" if abs(zeta) > 1e-12 else "damping ratio 0") in title
         across = np.sum(ly.get_ydata() ** 2) > np.sum(lz.get_ydata() ** 2)
         assert ("out-of-plane" in title) == across, (title, mode)
+
+
+def test_figures_and_series_of_a_run_that_did_not_complete_say_so(ex1, tmp_path, capsys):
+    """Only the netCDF status said that a run was interrupted (tester t63): the PNG carries
+    the step's status, the ParaView collection a comment, and both commands say it."""
+    tree, _ = ex1
+    status = "interrupted at t = 1.5 s (histories up to the output at t = 1.5 s)"
+    cut = tree.copy()
+    cut["release"] = cut["release"].to_dataset().sel(time=slice(0.0, 1.5)).assign_attrs(
+        status=status)
+    cut.attrs["status"] = f"interrupted in step 'release': {status}"
+    path = tmp_path / "cut.nc"
+    cut.to_netcdf(path)
+    assert main(["plot", str(path), "-o", str(tmp_path / "figs"), "--step", "release",
+                 "--what", "history"]) == 0
+    err = capsys.readouterr().err
+    assert "note: the run did not complete (interrupted in step 'release'" in err
+    made = []
+    original = plot._figure
+
+    def keep(*args):
+        made.append(original(*args))
+        return made[-1]
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(plot, "_figure", keep)
+        plot.write_all(catdae.read_results(path), tmp_path / "f2", steps="release",
+                       what="history")
+        plot.write_all(tree, tmp_path / "f3", steps="release", what="history")
+    cut_texts, whole_texts = ([t.get_text() for t in f.texts] for f in made)
+    assert f"step not completed: {status}" in cut_texts
+    assert not any("not completed" in t for t in whole_texts)
+    assert main(["export", str(path), "--vtk", str(tmp_path / "vtk"), "--step", "release"]) == 0
+    assert "the series hold what it computed" in capsys.readouterr().err
+    pvd = (tmp_path / "vtk" / "release.pvd").read_text()
+    assert f"<!-- step not completed: {status} -->" in pvd
+    done = main(["export", str(ex1[1]), "--vtk", str(tmp_path / "vtk2"), "--step", "release"])
+    assert done == 0 and "did not complete" not in capsys.readouterr().err
