@@ -17,7 +17,6 @@ import numpy as np
 
 from catdae._xr import xr
 from catdae.case import Case, Step, load_case
-from catdae.case.build_cables import MAX_STRAIN
 from catdae.case.frame import rotate_back, to_gravity_frame
 from catdae.case.sweep import apply_sweep
 from catdae.case.sweep import units as sweep_units
@@ -308,14 +307,6 @@ def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
     )
     ds = with_connector_forces(ds, model.connectors, sol.X)
     ds = with_static_fluid(ds, model.fluid, sol.X, state.t)  # the current, the wind (§13)
-    strain = ds.tension.values / model.elements.EA[:, None] if ds.sizes["element"] else None
-    if strain is not None and np.nanmax(strain) > MAX_STRAIN:  # the case check's bound
-        e = int(np.nanargmax(np.nanmax(strain, axis=1)))
-        ds.attrs["note"] = (
-            f"element {model.mesh.element_names[e]!r} is stretched by "
-            f"{100 * np.nanmax(strain[e]):.3g} % (T / EA): far beyond what a cable carries "
-            f"(the case check refuses {100 * MAX_STRAIN:g} % in the geometry); check the "
-            "loads and their units")
     if model.fluid is not None:
         ds = results.with_note(ds, plausibility_note(model.case, waves=False))
     return engineering.add_static(ds, span_quantities(model, sol.X, sol.state), model.case)

@@ -91,9 +91,10 @@ def strain_note(ds: xr.Dataset, case) -> str:
         t, ea = float(np.nanmax(top[ds.element_cable.values == name])), case.material_of(name).EA
         if t > MAX_STRAIN * ea:
             said.append(f"cable {name!r} reached a strain of {100 * t / ea:.3g} % (tension "
-                        f"{t:.4g} N), "
-                        f"beyond the {MAX_STRAIN:.0%} this model accepts (a linear elastic "
-                        "material): read its tensions and motion as outside the model's range")
+                        f"{t:.4g} N, T / EA), far beyond what a cable carries and the "
+                        f"{MAX_STRAIN:.0%} this model accepts (a linear elastic material; a "
+                        "case that needs more is refused when read): check the loads, the "
+                        "support motions and their units")
     return "; ".join(said)
 
 
