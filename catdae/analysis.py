@@ -248,7 +248,10 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
     targets hold in it (catdae.model.formfind). Returns (case with the lengths, its mesh at the
     reference temperature, the step's model, its dataset)."""
 
+    solves = []
+
     def evaluate(trial: Case, warm):
+        solves.append(trial)
         mesh = build_mesh(trial)
         model = Model(trial, mesh.heated(trial, temperature), removed)
         X, h = (mesh.X0, None) if warm is None else (warm[2].X, warm[2].state.h)
@@ -256,7 +259,8 @@ def _form_step(step: Step, case: Case, removed: set[str], temperature, state: _S
         return (mesh, model, sol), formfind.summary_of(trial, model, sol)
 
     found, (mesh, model, sol) = formfind.solve(case, evaluate)
-    return found, mesh, model, _static_result(model, state, sol)
+    return found, mesh, model, _static_result(model, state, sol).assign_attrs(
+        form_static_solves=len(solves))  # the search's cost: a static solve of the scene each
 
 
 def _static_solve(step: Step, model: Model, state: _State):

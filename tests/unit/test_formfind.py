@@ -210,6 +210,7 @@ def test_a_net_of_tension_targets_is_found_with_few_static_solves(monkeypatch):
     first = ds.cable_end_tension.sel(end="i").values
     np.testing.assert_allclose(first, 5000.0, rtol=10 * formfind.TOL)
     assert len(evaluations) <= 3 * (n + 1), len(evaluations)
+    assert ds.attrs["form_static_solves"] == len(evaluations)
     # the found lengths as given lengths, without form-finding: the same tensions
     plain = catdae.load_case(text)
     plain = dataclasses.replace(plain, cables=tuple(
