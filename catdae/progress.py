@@ -47,6 +47,7 @@ class _Compilations(event.Listener):
 
 
 _COMPILATIONS = _Compilations()
+_ANNOUNCED: list[bool] = []  # the compiling line was printed in this process
 event.register("numba:compile", _COMPILATIONS)
 
 
@@ -58,8 +59,9 @@ def compiling() -> bool:
 @contextmanager
 def announce_compiling(stream: IO[str] | None = None) -> Iterator[None]:
     """Within the block, the first time numba compiles a line on ``stream`` (default stderr)
-    says so: after an install or an upgrade the kernels take about a minute."""
-    said = []
+    says so, once per process (a run compiles some kernels in its static step and others in
+    its transient): after an install or an upgrade the kernels take about a minute."""
+    said = _ANNOUNCED
 
     def say():
         if not said:

@@ -198,9 +198,12 @@ def _span_lines(ds, k: int) -> list[str]:
                  "the chord; the largest offset from it is the sag above)",
                  f"lowest point {low:.6g} m below the lower end"]
     else:
-        parts = [f"sag at midspan {mid:.6g} m" + (" (above the chord: the cable bulges up)"
+        largest = float(ds.sag.values[k]) if "sag" in ds else np.nan
+        same = abs(mid - largest) <= 1e-6 * max(abs(largest), 1e-9)  # a level span's
+        parts = ["the largest sag is at midspan" if same else
+                 f"sag at midspan {mid:.6g} m" + (" (above the chord: the cable bulges up)"
                                                    if mid < 0 else ""),
-                 f"at the lowest point {low:.6g} m below the lower end",
+                 f"lowest point {low:.6g} m below the lower end",
                  f"swing angle {_deg(swing)} deg"]
     parts += _rated(ds, k)
     if "clearance" in ds:
@@ -233,7 +236,7 @@ def _cable_lines(ds) -> list[str]:
                                                if _across(whole, along) else ""))
         if np.isfinite(along):
             line += f", along the chord {along:.6g} N"
-        line += f"; sag {float(ds.sag.values[k]):.6g} m"
+        line += f"; largest sag {float(ds.sag.values[k]):.6g} m"
         if "unstrained_length" in ds:
             line += f"; L0 {float(ds.unstrained_length.values[k]):.9g} m"
         out.append(line)
