@@ -240,3 +240,23 @@ def test_the_swing_angle_over_a_transient_follows_a_slow_wind():
     # ramp of 1.5° per second)
     half = np.flatnonzero(ds.time.values >= 10.0)[0]
     assert angle[half] == pytest.approx(np.degrees(np.arctan(0.5 * p / w)) - 0.7, abs=0.3)
+
+
+def test_a_cable_jumping_above_its_chord_has_no_swing():
+    """The messenger wire of cases/ice_shedding.toml jumps above its chord after the ice
+    falls: there the line from the chord to the cable points up, which reads as a 180° "swing"
+    (printed as the largest swing of the event). The swing is NaN exactly while the midspan
+    node (a node of the even mesh) is above the chord's middle, finite below."""
+    from repo_paths import CASES
+
+    ds = catdae.run(CASES / "ice_shedding.toml")["shedding"].ds
+    z = ds.position.sel(axis="z")
+    cable = str(ds.cable.values[0])
+    nodes = ds.element_node.values[ds.element_cable.values == cable]
+    a, b = str(nodes[0, 0]), str(nodes[-1, 1])
+    mid = str(nodes[len(nodes) // 2, 0])  # the node at midspan (even element count)
+    above = (z.sel(node=mid) > 0.5 * (z.sel(node=a) + z.sel(node=b))).values
+    angle = ds.swing_angle.sel(cable=cable).values
+    assert above.any() and (~above).any()
+    assert np.isnan(angle[above]).all() and np.isfinite(angle[~above]).all()
+    assert float(ds.swing_angle_max.sel(cable=cable)) < 1.0  # a vertical jump: no swing
