@@ -15,9 +15,9 @@ shared free node) are solved together.
 Method: Newton on L around the static solve, with the Jacobian ∂r/∂L by forward differences
 (one warm-started static solve per form-found cable, each a few Newton iterations from the
 base equilibrium), kept up to date between them by Broyden's rank-one update from each step
-taken (differences again when a step leads nowhere), and a
-backtracking line search on |r|. This reuses the static solver as it
-is (load stepping, line search, slack elements) instead of adding the lengths to its unknowns:
+taken (differences again when a step leads nowhere), and a backtracking line search on |r|.
+This reuses the static solver as it is (load stepping, line search, slack elements) instead of
+adding the lengths to its unknowns:
 an augmented system would need ∂(element forces)/∂L0 and ∂(sag)/∂X from the kernel, which it
 does not provide. The cost is n static solves per Jacobian for n form-found cables, and one
 or a few per iteration.
