@@ -427,7 +427,9 @@ def grounded_catenary(span: float, height: float, L0: float, EA: float, w: float
 def grounded_line(span: float, height: float, segments) -> dict:
     """A mooring line of several uniform segments in series, ``segments`` = [(L0, EA, w), ...]
     from the fairlead down to the anchor on a frictionless seabed ``span`` away horizontally
-    and ``height`` below the fairlead; shot down from the fairlead.
+    and ``height`` below the fairlead; shot down from the fairlead. A fourth entry is a
+    vertical force at the segment's lower joint (up positive: a buoy; a clump weight is
+    negative), which V takes on below it (a joint that rests on the seabed passes it on).
 
     With the fairlead's forces (H, V), a segment hanging from the vertical tension V_top has
     V_bot = V_top - w L0 at its lower end; while V_bot >= 0 it is an elastic catenary
@@ -442,7 +444,7 @@ def grounded_line(span: float, height: float, segments) -> dict:
     def shoot(H, V):
         x = z = lying = 0.0
         joints = []
-        for L0, EA, w in segments:
+        for L0, EA, w, *up in segments:
             lo = V - w * L0
             if lo >= 0.0:
                 x += (H / w) * (math.asinh(V / H) - math.asinh(lo / H)) + H * L0 / EA
@@ -456,10 +458,11 @@ def grounded_line(span: float, height: float, segments) -> dict:
                 z += (H / w) * (math.hypot(1.0, V / H) - 1.0) + V * V / (2.0 * EA * w)
                 lying += L0 - ls
                 V = 0.0
+            V = max(V + (up[0] if up else 0.0), 0.0)  # a buoy (+) or clump (-) at the joint
             joints.append((x, z))
         return x, z, lying, joints
 
-    weight = sum(L0 * w for L0, _, w in segments)
+    weight = sum(seg[0] * seg[2] + abs(seg[3] if len(seg) > 3 else 0.0) for seg in segments)
 
     def v_of(H):
         return brentq(lambda V: shoot(H, V)[1] - height, 0.0, 4.0 * weight, xtol=1e-300,

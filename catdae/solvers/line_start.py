@@ -38,8 +38,10 @@ def line_paths(model, on_support: np.ndarray, t: float = 0.0
     ends = [(int(mesh.conn[els[0], 0]), int(mesh.conn[els[-1], 1]), els) for els in
             (np.flatnonzero(mesh.cable_of_element == ci) for ci in range(len(mesh.cable_names)))]
     degree = np.bincount([n for a, b, _ in ends for n in (a, b)], minlength=mesh.n_nodes)
-    bare = (degree == 2) & ~model.fixed_mask.any(axis=1) & (model.loading.node_mass <= 0.0)
-    bare &= ~np.any(model.nodal_load(t).reshape(-1, 3) != 0.0, axis=1)
+    # a junction may carry a vertical load (a clump weight, a buoy, a point mass's weight):
+    # the horizontal tension stays one along the line, the vertical one jumps there
+    bare = (degree == 2) & ~model.fixed_mask.any(axis=1)
+    bare &= ~np.any(model.nodal_load(t).reshape(-1, 3)[:, :2] != 0.0, axis=1)
     if model.connectors is not None:
         bare[model.connectors.ends.ravel()] = False
     loaded = np.diff(el.loads.ptr) > 0
@@ -66,31 +68,41 @@ def line_paths(model, on_support: np.ndarray, t: float = 0.0
     return out
 
 
-def _chord(h_top: float, v_top: float, el, path, e_h) -> np.ndarray:
-    """(span, rise, V left at the seabed end) of a path hanging from tension (H, V) at its
-    upper end, and each element's (Hx, Hy, V) in the element's own direction."""
+def _walk(h_top: float, v_top: float, el, path, e_h, jump) -> tuple[np.ndarray, list, bool]:
+    """(span and rise, each element's chord from the top down, whether a junction lifts a line
+    that touched down above it) of a path hanging from tension (H, V) at its upper end.
+    ``jump``: the vertical force at each element's lower-end node (a buoy up, a clump down;
+    0 at the path's lower end), added to V below it."""
     d = np.zeros(3)
     f = np.zeros(6)
     total = np.zeros(2)
-    v = v_top
-    for e in reversed(path):
+    chords = []
+    v, relifted = v_top, False
+    for e, up in zip(reversed(path), reversed(jump), strict=True):
         w, l0 = float(el.w[e]), float(el.L0[e])
         v_low = v - w * l0  # V continued to the element's lower end
         g.chord_grounded(h_top * e_h[0], h_top * e_h[1], v_low, w, float(el.EA[e]), l0,
                          g.AT_I, d, f, False)
+        chords.append(d.copy())
         total[0] += d[0] * e_h[0] + d[1] * e_h[1]
         total[1] += d[2]
-        v = max(v_low, 0.0)
-    return total
+        relifted |= v_low < 0.0 and up > 0.0  # an S-shape this walk does not describe
+        v = max(max(v_low, 0.0) + up, 0.0)
+    return total, chords, relifted
 
 
-def _solve(el, path, span: float, rise: float, e_h) -> tuple[float, float]:
+def _chord(h_top: float, v_top: float, el, path, e_h, jump) -> np.ndarray:
+    """(span, rise) of a path hanging from tension (H, V) at its upper end (:func:`_walk`)."""
+    return _walk(h_top, v_top, el, path, e_h, jump)[0]
+
+
+def _solve(el, path, span: float, rise: float, e_h, jump) -> tuple[float, float]:
     """(H, V at the upper end) of the line through span and rise (both > 0), by bisection."""
-    weight = float((el.w[path] * el.L0[path]).sum())
+    weight = float((el.w[path] * el.L0[path]).sum() + np.abs(jump).sum())
 
     def v_for(h):
         def f(v):
-            return _chord(h, v, el, path, e_h)[1] - rise
+            return _chord(h, v, el, path, e_h, jump)[1] - rise
         hi = weight
         for _ in range(200):
             if f(hi) >= 0.0:
@@ -99,7 +111,7 @@ def _solve(el, path, span: float, rise: float, e_h) -> tuple[float, float]:
         return brentq(f, 0.0, hi, xtol=1e-12 * weight, rtol=1e-14, maxiter=200)
 
     def fs(h):
-        return _chord(h, v_for(h), el, path, e_h)[0] - span
+        return _chord(h, v_for(h), el, path, e_h, jump)[0] - span
 
     lo = 1e-9 * weight
     hi = weight
@@ -111,7 +123,7 @@ def _solve(el, path, span: float, rise: float, e_h) -> tuple[float, float]:
     return h, v_for(h)
 
 
-def place_line(model, X: np.ndarray, path, fwd) -> bool:
+def place_line(model, X: np.ndarray, path, fwd, t: float = 0.0) -> bool:
     """Put the inner nodes of ``path`` (lower end first) on the line's equilibrium (in place);
     False when it is not found (the start is then left as it was)."""
     el = model.elements
@@ -123,19 +135,17 @@ def place_line(model, X: np.ndarray, path, fwd) -> bool:
     if span <= 0.0 or c[2] <= 0.0:
         return False
     e_h = c[:2] / span
+    lower = [int(conn[e, 0] if forward else conn[e, 1]) for e, forward in zip(path, fwd,
+                                                                             strict=True)]
+    fz = model.nodal_load(t).reshape(-1, 3)[:, 2]
+    jump = np.array([0.0] + [float(fz[n]) for n in lower[1:]])  # at each element's lower end
     try:
-        h, v = _solve(el, path, span, float(c[2]), e_h)
+        h, v = _solve(el, path, span, float(c[2]), e_h, jump)
     except (ValueError, RuntimeError, OverflowError):
         return False
-    d = np.zeros(3)
-    f = np.zeros(6)
-    chords = []
-    for e in reversed(path):
-        w, l0 = float(el.w[e]), float(el.L0[e])
-        g.chord_grounded(h * e_h[0], h * e_h[1], v - w * l0, w, float(el.EA[e]), l0, g.AT_I,
-                         d, f, False)
-        chords.append(d.copy())
-        v = max(v - w * l0, 0.0)
+    _, chords, relifted = _walk(h, v, el, path, e_h, jump)
+    if relifted:  # a buoy lifting a line that lies on the seabed above it: not this shape
+        return False
     x = X[a].copy()
     for e, forward, ch in zip(path[:-1], fwd[:-1], chords[::-1][:-1], strict=True):
         x = x + ch

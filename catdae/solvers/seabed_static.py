@@ -235,7 +235,7 @@ def grounded_start(model: Model, X: np.ndarray, on_support: np.ndarray, t: float
         X[inner] = X[a] + out[0]
     for path, fwd in line_paths(model, on_support, t):
         if np.unique(mesh.cable_of_element[path]).size > 1:
-            place_line(model, X, path, fwd)
+            place_line(model, X, path, fwd, t)
     return X
 
 

@@ -83,6 +83,40 @@ def test_chain_wire_chain_line_is_the_shooting_solution(j1, j2, reverse):
     assert td == pytest.approx([x1 - in_wire * (1.0 + H / WIRE["EA"]), 0.0, -200.0], abs=1e-6)
 
 
+@pytest.mark.parametrize("buoy, clump", [(3.0e4, 0.0), (2.0e4, -5.0e4), (1.0e4, 0.0)])
+def test_a_buoy_and_a_clump_at_the_junctions_are_the_shooting_solution(buoy, clump):
+    """A tester's chain-wire-chain line with a buoy at the upper junction (and a clump at the
+    lower one, resting on the seabed) had no static solution on the rigid seabed above a
+    10 kN buoy ("ramped up to 0 %"), though MoorPy found one (H = 99 954 N for 30 kN): the
+    line's start now carries the vertical loads at its junctions. Against the shooting
+    solution with the same jumps of V."""
+    w_c, w_w = w_sub(CHAIN), w_sub(WIRE)
+    ref = grounded_line(750.0, 190.0, [(150.0, CHAIN["EA"], w_c, buoy),
+                                       (400.0, WIRE["EA"], w_w, clump),
+                                       (300.0, CHAIN["EA"], w_c)])
+    text = scene(head={"title": "buoyed line"}, materials={"chain": CHAIN, "wire": WIRE},
+                 nodes={"anchor": (-750.0, 0.0, -200.0), "J1": (-480.0, 0.0, -199.0),
+                        "J2": (-100.0, 0.0, -120.0), "fairlead": (0.0, 0.0, -10.0)},
+                 supports=("anchor", "fairlead"),
+                 cables=[cable("bottom", ("anchor", "J1"), "chain", 300.0, 10),
+                         cable("wire", ("J1", "J2"), "wire", 400.0, 10),
+                         cable("top", ("J2", "fairlead"), "chain", 150.0, 5)],
+                 extra=(section("water", depth=200.0) + section("seabed", z=-200.0)
+                        + "".join(f'[[loads]]\nname = "{n}"\nnode = "{j}"\n'
+                                  f"force = [0.0, 0.0, {f!r}]\n"
+                                  for n, j, f in (("buoy", "J2", buoy), ("clump", "J1", clump))
+                                  if f)))
+    ds = run_static(text)
+    H, V = ref["H"], ref["V"]
+    if buoy == 3.0e4 and not clump:
+        assert H == pytest.approx(99954.0, rel=1e-5)  # MoorPy's figure, the tester's run
+    assert ds.reaction.sel(node="fairlead").values == pytest.approx([H, 0.0, V], rel=1e-7)
+    (x2, d2), (x1, d1), _ = ref["joints"]
+    assert ds.position.sel(node="J2").values == pytest.approx([-x2, 0.0, -10.0 - d2], abs=1e-6)
+    assert ds.position.sel(node="J1").values == pytest.approx([-x1, 0.0, -10.0 - d1], abs=1e-6)
+    assert float(ds.seabed_length.sum()) == pytest.approx(ref["lying_length"], rel=1e-7)
+
+
 def test_line_longer_than_span_plus_depth_is_refused():
     """2200 m of chain from an anchor 1400 m out to a fairlead 600 m up: H = 0 (MoorPy:
     V = w depth at the fairlead, the rest on the seabed), with 200 m to spare lying slack
