@@ -61,10 +61,12 @@ _PUBLIC = {"plot": "catdae.output.plot", "export": "catdae.output.export"}
 
 
 def __getattr__(name):
-    """``catdae.plot`` and ``catdae.export`` (catdae/output/) on first use (matplotlib, meshio
-    load then)."""
+    """``catdae.plot`` and ``catdae.export`` (catdae/output/), and ``catdae.study``, on first
+    use (matplotlib, meshio, Dask load then)."""
     if name in _PUBLIC:
         return importlib.import_module(_PUBLIC[name])
+    if name == "study":  # catdae/study/, with Dask, on first use
+        return importlib.import_module("catdae.study")
     raise AttributeError(f"module 'catdae' has no attribute {name!r}")
 
 

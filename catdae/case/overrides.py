@@ -108,11 +108,15 @@ def with_overrides(self: Case, rtol: float | None = None, atol: float | None = N
 
 
 def max_order_arg(text: str) -> int | str:
-    """``--max-order`` of ``catdae run`` and ``catdae study``: "auto" or an integer (its range
-    is judged with the case's own field)."""
+    """``--max-order`` of ``catdae run`` and ``catdae study``: "auto" or an integer 1 to 5,
+    refused by the command line itself otherwise (as a --mass-model that is none: an option
+    given on the command line is not a field of the case file)."""
     if text == "auto":
         return text
     try:
-        return int(text)
+        value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}") from None
+        value = 0
+    if not 1 <= value <= 5:
+        raise argparse.ArgumentTypeError(f"expected auto or 1-5, found {text!r}")
+    return value

@@ -180,7 +180,8 @@ def _mass_note(model: Model, prob) -> str:
         return ""
     t, dv, lam2 = jumps[0]
     return (f"a support velocity jumps by up to {dv:.3g} m/s at t = {t:.6g} s: the axial "
-            "(water-hammer) wave it sends is not carried by the consistent catenary mass of "
-            f"elements that take a chord change by sag (element λ² up to {lam2:.3g} here, "
+            f"(water-hammer) wave it sends is not carried by the {model.mass_model.name} mass "
+            f"(catenary) of elements that take a chord change by sag (element λ² up to "
+            f"{lam2:.3g} here, "
             "> 1); tensions may be underestimated (try mass_model = \"lumped\" or \"linear\", "
             "or more elements; docs/accuracy.md)")

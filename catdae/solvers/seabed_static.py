@@ -63,9 +63,15 @@ def solve_static_seabed(model: Model, zb: float, X, h0=None, t: float = 0.0,
     k = float(np.max(mesh.w / (1e-4 * mesh.L0)))
     penalty = ContactModel(model, SeabedContact.of_model(model, stiffness=k,
                                                          width=np.ones(mesh.n_elements)))
-    pre = solve_static(penalty, X, None, t=t, load_steps=load_steps)
-    # pre is the equilibrium at the full loads: the active set starts there, without a ramp
-    return _active_set(model, zb, pre.X, None, t, 1, max_rounds, ztol, fscale, support_on)
+    try:
+        pre = solve_static(penalty, X, None, t=t, load_steps=load_steps)
+        # pre is the equilibrium at the full loads: the active set starts there, without a ramp
+        return _active_set(model, zb, pre.X, None, t, 1, max_rounds, ztol, fscale, support_on)
+    except ConvergenceError as exc:
+        raise ConvergenceError(
+            f"{exc} (on the rigid seabed, from its active-set start, a ramp of the loads and a "
+            "penalty start; contact springs, [seabed] stiffness and damping, reach such scenes "
+            "from any start: docs/case-format.md, \"Seabed\")") from exc
 
 
 def _current_ramp(model, zb, X, args):

@@ -257,7 +257,15 @@ def _execute_all(todo: Mapping[str, Case], step_name: str, memory: str, schedule
         if isinstance(scheduler, Client):
             client = scheduler
         elif scheduler is None:
-            cluster = stack.enter_context(local_cluster(workers))
+            try:
+                cluster = stack.enter_context(local_cluster(workers))
+            except RuntimeError as exc:  # "Nanny failed to start": a script without the guard
+                raise StudyError(
+                    f"the local Dask cluster's worker processes did not start ({exc}): a "
+                    "script that calls run_study with the default scheduler needs the "
+                    "'if __name__ == \"__main__\":' guard (the workers are new processes that "
+                    "import the script again, and ran it), or scheduler=\"synchronous\" "
+                    "to run here") from exc
             client = stack.enter_context(Client(cluster))
         else:
             client = stack.enter_context(Client(scheduler))
