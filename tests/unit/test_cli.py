@@ -263,3 +263,25 @@ def test_a_run_under_a_profiler_ends_the_ordinary_way_and_keeps_its_profile(tmp_
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert pstats.Stats(str(prof)).total_calls > 0
     assert catdae.read_results(out)["st"].position.notnull().all()
+
+
+def test_the_readme_first_case_runs_and_prints_the_closed_form(tmp_path, capsys):
+    """The README's first case, taken from the README itself: it runs, and the end tensions
+    and sag it prints are the elastic catenary's (Irvine's closed form, tests/reference.py),
+    as the README quotes them."""
+    import re
+
+    from reference import irvine_catenary
+    from repo_paths import ROOT
+
+    text = (ROOT / "README.md").read_text()
+    toml = re.search(r"```toml\n(.*?)```", text, re.S).group(1)
+    case = tmp_path / "span.toml"
+    case.write_text(toml)
+    assert main(["run", str(case), "-o", str(tmp_path / "span.nc"), "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    ref = irvine_catenary(100.0, 5.0, 100.8, 2.0e7, 1.5 * 9.81)
+    assert f"end tensions {ref['T_i']:.6g} N, {ref['T_j']:.6g} N" in out, out
+    assert f"largest sag {ref['sag']:.6g} m" in out
+    assert (f"end tensions ({ref['T_i']:.0f} and {ref['T_j']:.0f} N), the sag "
+            f"({ref['sag']:.2f} m)") in " ".join(text.split())
