@@ -291,13 +291,13 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
     ds = _static_result(model, state, sol)
     if summary is None:
         return ds
-    from catdae.output.seabed import add_seabed, sag_into_seabed
+    from catdae.output.seabed import add_seabed, static_seabed_note
 
     ds = add_seabed(ds, model.mesh, summary)
     if model.case.seabed.stiffness is None:
         return ds
-    # contact springs at the nodes (§17.5)
-    return results.with_note(ds, sag_into_seabed(ds, model.mesh, model.case.seabed.z))
+    # contact springs at the nodes (§17.5); no friction in statics
+    return results.with_note(ds, static_seabed_note(ds, model.mesh, model.case.seabed))
 
 
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:

@@ -23,6 +23,19 @@ def add_seabed(ds: xr.Dataset, mesh, summary: dict) -> xr.Dataset:
 SAG_SHARE = 0.05  # of an element's length: a sag into the seabed between nodes worth a word
 
 
+def static_seabed_note(ds: xr.Dataset, mesh, seabed) -> str:
+    """What a static step on the seabed's contact springs says: a cable sagging into them
+    (:func:`sag_into_seabed`), and that its friction was left out (a static state with
+    Coulomb friction is not unique: the frictionless one is given; docs/case-format.md)."""
+    said = [sag_into_seabed(ds, mesh, seabed.z)]
+    if seabed.friction_axial > 0.0 or seabed.friction_lateral > 0.0:
+        said.append("the seabed's friction is left out of static steps: this static state is "
+                    "the frictionless one (with Coulomb friction a resting line has a "
+                    "whole set of equilibria; the anchor tension is not reduced by friction "
+                    "here)")
+    return "; ".join(x for x in said if x)
+
+
 def sag_into_seabed(ds: xr.Dataset, mesh, zb: float) -> str:
     """A note ("" when none) for a static state on contact springs in which a cable's lowest
     point hangs below the seabed and below its lowest node by more than SAG_SHARE of its

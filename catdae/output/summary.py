@@ -205,11 +205,21 @@ def _span_lines(ds, k: int) -> list[str]:
                                                    if mid < 0 else ""),
                  f"lowest point {low:.6g} m below the lower end",
                  f"swing angle {_deg(swing)} deg"]
-    parts += _rated(ds, k)
+    parts += _rated(ds, k) + _seabed_part(ds, k)
     if "clearance" in ds:
         parts.append(f"clearance above the ground {float(ds.clearance.values[k]):.6g} m at "
                      f"s = {float(ds.clearance_s.values[k]):.6g} m")
     return ["      " + "; ".join(parts)]
+
+
+def _seabed_part(ds, k: int) -> list[str]:
+    """Cable k's length on the seabed and its touchdown point, when it rests on it."""
+    if "seabed_length" not in ds or not float(ds.seabed_length.values[k]) > 0.0:
+        return []
+    text = f"on the seabed {float(ds.seabed_length.values[k]):.6g} m"
+    if "touchdown" in ds and np.isfinite(ds.touchdown.values[k]).all():
+        text += ", touchdown at (" + ", ".join(f"{x:.6g}" for x in ds.touchdown.values[k]) + ") m"
+    return [text]
 
 
 def _across(whole: float, along: float) -> bool:

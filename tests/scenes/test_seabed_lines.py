@@ -277,3 +277,24 @@ def test_failed_static_names_the_node_with_the_largest_residual():
     assert found, str(err.value)
     assert found.group(1) in mesh.node_names and found.group(1) not in ("A", "B")
     assert float(found.group(3)) > 0.0
+
+
+def test_the_summary_gives_the_seabed_and_the_note_says_statics_has_no_friction():
+    """A mooring engineer reads the grounded length and the touchdown (the results held them,
+    the summary did not print them), and a static step on a seabed with friction says that its
+    state is the frictionless one (an anchor tension read as friction-reduced otherwise:
+    tester t67)."""
+    from catdae.output.summary import summary
+
+    text = mseg_toml((399.0, 0.0, -200.0), (40.0, 0.0, -45.0))
+    tree = catdae.run(load_case(text))
+    ds = tree[next(iter(tree.children))].to_dataset()
+    lying = float(ds.seabed_length.sel(cable="bottom"))
+    td = ds.touchdown.sel(cable="mid").values
+    printed = summary(tree)
+    assert f"on the seabed {lying:.6g} m" in printed
+    assert "touchdown at (" + ", ".join(f"{x:.6g}" for x in td) + ") m" in printed
+    assert "friction" not in ds.attrs.get("note", "")
+    springs = text.replace("[seabed]", "[seabed]\nstiffness = 1e6\nfriction = 0.5")
+    note = run_static(springs).attrs.get("note", "")
+    assert "this static state is the frictionless one" in note, note
