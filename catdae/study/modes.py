@@ -105,8 +105,30 @@ def match(ref: xr.Dataset, rec: xr.Dataset) -> tuple[np.ndarray, np.ndarray]:
         found = pair >= 0
         width = 3.0 * float(np.median(np.abs(f[pair[found]] / f_r[found] - 1.0)))
         if width > CLUSTER:
-            pair, best = _pairs(phi_r, phi, f_r, f, width)
+            _widen(phi_r, phi, f_r, f, width, pair, best)
     return pair, best
+
+
+def _widen(phi_r, phi, f_r, f, width: float, pair, best) -> None:
+    """Pairs of the wider clusters taken (in place) where a cluster's reference modes and
+    the run modes paired with them span the same shapes, each projecting on the other set
+    by MAC_MIN or more: a mesh mixes nearby modes but keeps their span. A cluster that only
+    gathers modes the run cannot represent (an inclined stay's n = 5 pair near a coarse
+    mesh's n = 4 pair, each at MAC 0.00 with it) keeps the first pairs."""
+    wide, score = _pairs(phi_r, phi, f_r, f, width)
+    cr = _clusters(f_r, width)
+    for c in np.unique(cr):
+        rows = np.flatnonzero(cr == c)
+        cols = wide[rows]
+        if rows.size < 2 or (cols < 0).any() or np.array_equal(cols, pair[rows]):
+            continue
+        others = np.delete(pair, rows)
+        if np.isin(cols, others[others >= 0]).any():
+            continue  # the run modes are taken by pairs outside the cluster
+        both = min(_projection(phi_r[rows], phi[cols]).min(),
+                   _projection(phi[cols], phi_r[rows]).min())
+        if both >= MAC_MIN:
+            pair[rows], best[rows] = cols, score[rows]
 
 
 def _pairs(phi_r, phi, f_r, f, width: float) -> tuple[np.ndarray, np.ndarray]:
