@@ -182,6 +182,15 @@ def test_a_load_shed_at_once_does_not_lower_the_tension_envelope_below_its_start
         assert "starts from" in ds[name].attrs["long_name"]
     plain = catdae.run(catdae.load_case(case()))["kicked"].ds  # no add, no remove
     assert "starts from" not in plain.tension_max.attrs["long_name"]
+    # a modal step between, about the state it found, changes nothing (tester t65)
+    from scene_toml import modal_step
+
+    text = shed("remove").replace('[[steps]]\nkind = "transient"',
+                                  modal_step(2) + '[[steps]]\nkind = "transient"', 1)
+    tree = catdae.run(catdae.load_case(text))
+    assert list(tree.children) == ["before", "modes", "event"]
+    np.testing.assert_array_equal(tree["event"].ds.tension_max.values.max(),
+                                  tree["before"].ds.tension.values.max())
 
 
 def test_a_strain_past_the_models_range_is_noted():
