@@ -530,3 +530,16 @@ def test_tensions_in_water_are_named_effective():
     assert tree["waves"].ds.tension_max.attrs["long_name"].startswith("largest effective")
     dry = catdae.run(load_case(_riser(water=False)))
     assert "effective" not in dry["still"].ds.tension.attrs["long_name"]
+
+
+def test_the_fast_current_note_counts_the_current_time_function():
+    """A 20 m/s current ramped to 0.4 of itself reaches 8 m/s: no note (it said "reaches
+    20 m/s" with the step seeing 8: tester t65); ramped to 0.8, 16 m/s, noted with that."""
+    for amplitude, said in ((0.4, None), (0.8, "the current reaches 16 m/s")):
+        current = {"velocity": [20.0, 0.0, 0.0],
+                   "time": {"kind": "ramp", "duration": 0.01, "amplitude": amplitude}}
+        tree = catdae.run(load_case(_riser(current=current)))
+        note = tree["waves"].ds.attrs.get("note", "") + tree["still"].ds.attrs.get("note", "")
+        assert (said in note) if said else ("current reaches" not in note), note
+        u = np.nanmax(tree["waves"].ds.fluid_velocity.sel(axis="x").values)
+        assert u == pytest.approx(20.0 * amplitude, rel=1e-9)
