@@ -233,8 +233,8 @@ def _catenary_points(case, cable, a, b, ea, w, s_nodes) -> np.ndarray:
     """Points at arc lengths s_nodes on the elastic catenary from a to b (self-weight only).
 
     A weightless cable that is not taut has no shape of its own; it is then meshed under its
-    own point loads and point masses (which the case validation requires it to carry), and
-    failing that on the straight chord.
+    own point loads, point masses and distributed loads (which the case validation requires it
+    to carry), and failing that on the straight chord.
     """
     if len(s_nodes) == 0:
         return np.zeros((0, 3))
@@ -252,6 +252,12 @@ def _catenary_points(case, cable, a, b, ea, w, s_nodes) -> np.ndarray:
 
     items = [(s_of(pm), (0.0, 0.0, -pm.mass * case.gravity)) for pm in case.point_masses]
     items += [(s_of(ld), tuple(ld.force)) for ld in case.loads]
+    for dl in case.distributed_loads:  # a wind on a weightless line: 8 point loads for a shape
+        if dl.cable == cable.name:
+            lo, hi = dl.from_s, min(dl.to_s, cable.length)
+            ds = (hi - lo) / 8.0
+            items += [(lo + (k + 0.5) * ds, tuple(ds * np.asarray(dl.load, float)))
+                      for k in range(8)]
     items = [(s, f) for s, f in items if s is not None]
     if items:
         el = Elements([cable.length], [ea], [w], PointLoads.from_lists([items]))
@@ -259,6 +265,7 @@ def _catenary_points(case, cable, a, b, ea, w, s_nodes) -> np.ndarray:
         if st.converged[0] and st.status[0] != SLACK:
             return a + el.position(st.h, s_nodes[None])[0]
     if w == 0.0 and not items:
-        raise CaseError(case.path, [(f"cables.{cable.name}", "weightless cable is slack "
-                                     "(length >= chord) and carries nothing: no defined shape")])
+        where = f"cables[{case.cables.index(cable)}]"
+        raise CaseError(case.path, [(where, f"weightless cable {cable.name!r} is slack (length "
+                                     ">= chord) and carries nothing: no defined shape")])
     return a + np.outer(s_nodes / cable.length, b - a)

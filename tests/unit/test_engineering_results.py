@@ -269,3 +269,21 @@ def test_a_cable_jumping_above_its_chord_has_no_swing():
     assert above.any() and (~above).any()
     assert np.isnan(angle[above]).all() and np.isfinite(angle[~above]).all()
     assert float(ds.swing_angle_max.sel(cable=cable)) < 1.0  # a vertical jump: no swing
+
+
+def test_a_weightless_slack_line_under_a_wind_is_meshed_under_it():
+    """No gravity, a 100 m chord, 100.2 m of line, 50 N/m across it (tester t65: refused as
+    'carries nothing' by the mesh, whose start only looked at point loads): the line hangs in
+    the horizontal plane as an elastic catenary of weight 50 N/m, Irvine's closed form."""
+    from reference import irvine_catenary
+
+    text = cable_scene(B=(100.0, 0.0, 0.0), L0=100.2, EA=2.0e8, mass=1.0, gravity=0.0,
+                       elements=20, extra="[[distributed_loads]]\nname = \"wind\"\n"
+                       "cable = \"c\"\nload = [0.0, 50.0, 0.0]\n", steps=static_step("st"))
+    ds = catdae.run(catdae.load_case(text))["st"].ds
+    ref = irvine_catenary(100.0, 0.0, 100.2, 2.0e8, 50.0)
+    # the wind at Gauss points: second order in the element length (docs/accuracy.md)
+    assert float(ds.horizontal_tension_along_chord.sel(cable="c")) == pytest.approx(
+        ref["H"], rel=1e-3)
+    mid = ds.position.sel(node="c.10").values
+    assert mid[1] == pytest.approx(ref["sag"], rel=1e-3) and abs(mid[2]) < 1e-9
