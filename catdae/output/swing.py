@@ -14,11 +14,14 @@ import numpy as np
 
 from catdae._xr import xr
 
+JUMP_ANGLE = 135.0  # degrees: past it the cable is above its chord more than beside it
+
 
 def _swing(P: np.ndarray, up: np.ndarray) -> np.ndarray:
     """Swing angles (degrees) of one cable's node line P (time, n_along, 3); NaN where the
     chord is vertical, the line does not cross its horizontal middle, or the cable is above
-    its chord there (a jump: no sag to swing; the static groups read that as 180°)."""
+    its chord more than beside it (past JUMP_ANGLE: a jump, no sag to swing; the static
+    groups read a cable straight above its chord as 180°)."""
     a, c = P[:, 0], P[:, -1] - P[:, 0]
     c_h = c - np.outer(c @ up, up)  # the chord's horizontal part
     ch = np.linalg.norm(c_h, axis=1)
@@ -37,7 +40,9 @@ def _swing(P: np.ndarray, up: np.ndarray) -> np.ndarray:
     lateral = d - np.outer(down, up) - np.einsum("tk,tk->t", d, u_dir)[:, None] * u_dir
     angle = np.degrees(np.arctan2(np.linalg.norm(lateral, axis=1), down))
     straight = np.linalg.norm(d, axis=1) <= 1e-12 * np.linalg.norm(c, axis=1)
-    ok &= straight | (down > 0.0)  # above its chord (a jump) a cable has no swing
+    # above its chord more than beside it (angle past 135°): a jump (ice shedding), no swing;
+    # a blow-out past horizontal (a gust's 110°) is a swing and is kept
+    ok &= straight | (angle <= JUMP_ANGLE)
     return np.where(ok, np.where(straight, 0.0, angle), np.nan)
 
 
@@ -61,7 +66,8 @@ def swing_over_time(ds: xr.Dataset, cables: list[str],
     when = np.where(found, ds.time.values[k], np.nan)
     what = ("angle from the vertical of the line from the chord to the cable where it is "
             "horizontally halfway between its ends (swing under loads across the span), "
-            "on the line through the nodes; NaN while the cable is above its chord there")
+            "on the line through the nodes; NaN while the cable is above its chord more than "
+            "beside it (past 135 degrees: a jump)")
     return {
         "swing_angle": xr.Variable(("time", "cable"), angle,
                                    {"units": "degree", "long_name": what}),
