@@ -268,20 +268,20 @@ class Model(MassMatrices):
         return self.elements.end_tensions(state.h)
 
     def cable_summary(self, X: np.ndarray, state: ElementState,
-                      sag: bool = True) -> dict[str, np.ndarray]:
+                      sag: bool | frozenset = True) -> dict[str, np.ndarray]:
         """Per cable: tension at its two ends, horizontal tension at its first end, sag, and
         unstrained length (at the reference temperature).
 
         Sag is the largest vertical distance from the chord to the cable (sampled on the exact
         curve of every element); for a vertical chord, the largest distance from the chord.
         Without ``sag`` it is NaN (its search along the curve costs most: form-finding to
-        tensions asks for the rest hundreds of times).
+        tensions asks for the rest hundreds of times); a set of cable indices limits it to them.
         """
         mesh = self.mesh
         nc = len(mesh.cable_names)
         end_t = np.zeros((nc, 2))
         h_t = np.zeros(nc)
-        sags = np.zeros(nc) if sag else np.full(nc, np.nan)
+        sags = np.full(nc, np.nan)  # where searched: every cable, or those in ``sag``
         tens = self.tensions(state)
         s = np.linspace(0.0, 1.0, 17)[None, :] * mesh.L0[:, None]  # (n_elem, 17)
         pts = (X[mesh.conn[:, 0]][:, None, :] + self.elements.position(state.h, s)) if sag \
@@ -290,7 +290,7 @@ class Model(MassMatrices):
             els = np.flatnonzero(mesh.cable_of_element == ci)
             end_t[ci] = tens[els[0], 0], tens[els[-1], 1]
             h_t[ci] = float(np.hypot(*state.h[els[0], :2]))
-            if not sag:
+            if not sag or (isinstance(sag, frozenset) and ci not in sag):
                 continue
             a = X[mesh.conn[els[0], 0]]
             b = X[mesh.conn[els[-1], 1]]

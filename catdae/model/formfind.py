@@ -191,10 +191,11 @@ def _single_cable(form, chord, end, ea, w, f) -> tuple[float | None, str]:
 
 
 def summary_of(case: Case, model, sol) -> dict:
-    """What :func:`measure` needs of a solved trial (Model.cable_summary): the sags only where
-    a target is a sag (their search along the curve was 80 % of a net's form-finding)."""
-    sag = any(case.cables[i].form.kind == "sag" for i in pending(case))
-    return model.cable_summary(sol.X, sol.state, sag=sag)
+    """What :func:`measure` needs of a solved trial (Model.cable_summary): the sags only of the
+    cables whose target is a sag (their search along the curve was 80 % of a net's
+    form-finding)."""
+    sags = frozenset(i for i in pending(case) if case.cables[i].form.kind == "sag")
+    return model.cable_summary(sol.X, sol.state, sag=sags if sags else False)
 
 
 def measure(case: Case, summary: dict) -> np.ndarray:
