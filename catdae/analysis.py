@@ -32,6 +32,7 @@ from catdae.model.span import span_quantities
 from catdae.output import engineering, results
 from catdae.output.connectors import with_connector_forces, with_damped_modes
 from catdae.output.fluid import effective_tension, with_static_fluid
+from catdae.output.reading import join_values, per_value
 from catdae.output.transient import as_dataset
 from catdae.output.writer import ResultWriter
 from catdae.solvers.damped_modes import solve_damped
@@ -183,13 +184,7 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
         model = step_model(case_v, mesh.heated(case_v, temp_v), absent, step, run_state)
         groups.append(_run_step(step_v, model, run_state, None, progress, settle=settle))
     state.__dict__.update(run_state.__dict__)
-    ds = xr.concat(groups, dim="sweep", combine_attrs="drop_conflicts")
-    varying = sorted(k for k in {k for g in groups for k in g.attrs} if k not in ds.attrs  # differ
-                     or any(k not in g.attrs for g in groups))  # by value, or some lack them
-    for key in varying:
-        values = [g.attrs.get(key, "") for g in groups]
-        numbers = all(isinstance(v, int | float | np.number) for v in values)
-        ds.attrs[key] = np.array(values) if numbers else " | ".join(map(str, values))
+    ds, varying = join_values(groups)
     ds = ds.assign_coords(sweep=xr.Variable("sweep", np.array(step.sweep.values), {
         "units": sweep_units(field), "long_name": f"swept value of {field}"}))
     return ds.assign_attrs(sweep_field=field, sweep_attributes=" ".join(varying)), temp_v
@@ -350,8 +345,9 @@ def engineering_results(step: Step, ds: xr.Dataset, case: Case,
     if step.kind == "transient":
         ref = groups.get(step.jump_reference) if step.jump_reference else None
         ds = ds.assign_attrs(jump_reference=step.jump_reference) if ref is not None else ds
-        ds = engineering.add_transient(ds, case, ref, -np.asarray(case.gravity_direction, float),
-                                       start=engineering.start_tension(step, groups))
+        start = engineering.start_tension(step, groups)
+        ds = per_value(ds, lambda d: engineering.add_transient(
+            d, case, ref, -np.asarray(case.gravity_direction, float), start=start))
     if step.kind != "modal" and names and _thermal(case):
         ds = engineering.add_temperatures(ds, names, temperature, case.reference_temperature)
     return effective_tension(ds, case.water is not None)

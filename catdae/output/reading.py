@@ -86,6 +86,40 @@ def step_values(name: str, ds: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
     return out
 
 
+def join_values(groups: list[xr.Dataset]) -> tuple[xr.Dataset, list[str]]:
+    """The groups of a sweep's values as one along ``sweep`` (the inverse of
+    :func:`step_values`): attributes that differ between the values, or that some lack, become
+    arrays over them (numbers) or their texts joined by " | ". Returns (dataset, those
+    attributes' names)."""
+    ds = xr.concat(groups, dim="sweep", combine_attrs="drop_conflicts")
+    varying = sorted(k for k in {k for g in groups for k in g.attrs} if k not in ds.attrs  # differ
+                     or any(k not in g.attrs for g in groups))  # by value, or some lack them
+    for key in varying:
+        values = [g.attrs.get(key, "") for g in groups]
+        numbers = all(isinstance(v, int | float | np.number) for v in values)
+        ds.attrs[key] = np.array(values) if numbers else " | ".join(map(str, values))
+    return ds, varying
+
+
+def per_value(ds: xr.Dataset, fn) -> xr.Dataset:
+    """``fn`` of a step's group, or of each value of a swept one (with that value's
+    attributes), joined again: the engineering results of a swept transient (they failed on
+    the sweep dimension: an independent tester's swept load and damper)."""
+    if "sweep" not in ds.dims:
+        return fn(ds)
+    parts = []
+    for _, one in step_values("", ds):
+        one.attrs.pop("sweep_value", None)
+        one.attrs["title"] = ds.attrs.get("title", "")
+        if "title" not in ds.attrs:
+            del one.attrs["title"]
+        parts.append(fn(one))
+    out, varying = join_values(parts)
+    listed = set(str(ds.attrs.get("sweep_attributes", "")).split())
+    return out.assign_attrs(sweep_field=ds.attrs.get("sweep_field", ""),
+                            sweep_attributes=" ".join(sorted(listed | set(varying))))
+
+
 def _value_attr(v, k: int, n: int):
     """The k-th value's attribute of a swept step's attribute ``v`` (n values)."""
     if np.ndim(v) == 1 and len(v) == n:

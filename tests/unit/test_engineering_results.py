@@ -309,3 +309,27 @@ def test_a_sudden_gust_swings_a_span_past_horizontal_and_the_swing_is_kept():
     assert top > 95.0 and top == pytest.approx(110.0, abs=12.0), top
     k = int(np.nanargmax(angle))
     assert np.isfinite(angle[: k + 1]).all()  # no gap on the way out
+
+
+def test_a_swept_transient_gets_the_engineering_results_of_each_value():
+    """Any step may be swept (docs/case-format.md); a swept transient failed in its
+    engineering results (the envelopes did not expect the sweep dimension: tester t70). Each
+    value's envelopes, swing and tension peak are those of the same scene run alone with the
+    load scaled by hand."""
+    def scene_with(force, sweep=""):
+        return cable_scene(B=(10.0, 0.0, 0.0), L0=10.5, EA=3.4e7, mass=5.0, elements=6,
+                           extra=load("p", [0.0, 0.0, force], node="c.3", active=False),
+                           steps=static_step("rest") + step(
+                               "transient", "drop", add=["p"], duration=0.3,
+                               output_interval=0.01, mass_model="lumped", rtol=1e-7,
+                               atol=1e-9) + sweep)
+
+    swept = catdae.run(catdae.load_case(scene_with(
+        -100.0, 'sweep = { field = "load_factor", values = [0.5, 1.0] }\n')))["drop"].ds
+    assert swept.sizes["sweep"] == 2
+    for k, factor in enumerate((0.5, 1.0)):
+        alone = catdae.run(catdae.load_case(scene_with(-100.0 * factor)))["drop"].ds
+        one = swept.isel(sweep=k)
+        for v in ("displacement_max", "reaction_min", "tension_max", "swing_angle_max"):
+            np.testing.assert_allclose(one[v].values, alone[v].values, rtol=1e-6, atol=1e-9,
+                                       err_msg=v)
