@@ -49,6 +49,7 @@ class _State:
         self.h: np.ndarray | None = None  # (n_elem, 3) N, warm start
         self.snap = ""  # the step that took the lumped mass for a snap (auto), if the last
         self.t = 0.0
+        self.unbalanced = False  # after a sweep: a modal step finds its own equilibrium
 
 
 def as_case(case_or_path: Case | str | os.PathLike, elements: int | None = None) -> Case:
@@ -184,6 +185,8 @@ def _sweep_step(step: Step, case: Case, mesh, absent: set[str], temperature, sta
         model = step_model(case_v, mesh.heated(case_v, temp_v), absent, step, run_state)
         groups.append(_run_step(step_v, model, run_state, None, progress, settle=settle))
     state.__dict__.update(run_state.__dict__)
+    # the last value's state, under loads or connectors the later steps do not have
+    state.unbalanced = settle and field != "temperature_change" and step.kind != "transient"
     ds, varying = join_values(groups)
     ds = ds.assign_coords(sweep=xr.Variable("sweep", np.array(step.sweep.values), {
         "units": sweep_units(field), "long_name": f"swept value of {field}"}))
@@ -213,7 +216,8 @@ def _run_step(step: Step, model: Model, state: _State, writer, progress,
     if step.kind == "static":
         return _static_step(step, model, state)
     if step.kind == "modal":
-        if settle or step.add or step.remove or step.temperature_change is not None:
+        if (settle or step.add or step.remove or step.temperature_change is not None
+                or state.unbalanced):
             its = _static_solve(step, model, state)[0].iterations
             return _modal_step(step, model, state).assign_attrs(equilibrium=(
                 f"found again for the step's own scene ({its} Newton iterations)"))
@@ -276,7 +280,7 @@ def _static_solve(step: Step, model: Model, state: _State):
         if not hint:
             raise
         raise ConvergenceError(f"{exc} ({hint})") from exc
-    state.X, state.h = sol.X, sol.state.h
+    state.X, state.h, state.unbalanced = sol.X, sol.state.h, False
     state.V = np.zeros_like(sol.X)
     return sol, model, summary
 
@@ -296,7 +300,7 @@ def _static_step(step: Step, model: Model, state: _State) -> xr.Dataset:
 
 
 def _static_result(model: Model, state: _State, sol) -> xr.Dataset:
-    state.X, state.h = sol.X, sol.state.h
+    state.X, state.h, state.unbalanced = sol.X, sol.state.h, False
     state.V = np.zeros_like(sol.X)
     ds = results.static_dataset(
         model.mesh, sol.X, model.tensions(sol.state), model.reactions(sol.state, state.t, sol.X),
