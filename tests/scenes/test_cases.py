@@ -61,8 +61,10 @@ def test_every_case_loads_and_runs(path):
         assert ds.attrs.get("status", "completed") == "completed", name
         for v in ds.data_vars:
             values = ds[v].values
-            # reactions and their envelopes are NaN where a node is free
-            if values.dtype.kind == "f" and not v.startswith("reaction"):
+            # reactions and their envelopes are NaN where a node is free; a transient's swing
+            # angle where the cable is above its chord more than beside it (a jump)
+            if values.dtype.kind == "f" and not v.startswith("reaction") and not (
+                    v.startswith("swing_angle") and "time" in ds.dims):
                 assert np.isfinite(values).all(), (name, v)
 
 
