@@ -41,13 +41,17 @@ def check_steps(case: Case, mesh) -> None:
         model = Model(case, mesh, absent, mass_model=step.mass_model, kind=step.kind)
         massless = model.lumped_mass_diag().reshape(-1, 3)[:, 0] <= 0.0
         free = ~model.fixed_mask.all(axis=1)
-        names = [mesh.node_names[k] for k in np.flatnonzero(massless & free)]
+        nodes = np.flatnonzero(massless & free)
+        names = [mesh.node_names[k] for k in nodes]
         if names:
             shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5
                                             else "")
+            on_cable = bool((mesh.cable_of_node[nodes] >= 0).any())
             problems.append((f"steps[{i}]", f"transient step '{step.name}': free node(s) "
-                             f"{shown} have no mass, so no acceleration is defined: give the "
-                             "cable's material a mass > 0 or put a point mass there"))
+                             f"{shown} have no mass, so no acceleration is defined: "
+                             + ("give the cable's material a mass > 0 or put a point mass "
+                                "there" if on_cable else "put a point mass there (no cable "
+                                "reaches it), or support it")))
     if problems:
         raise CaseError(case.path, problems)
 
