@@ -166,8 +166,12 @@ def _jump_lines(ds) -> list[str]:
                             else "") + f", s = {float(ds.jump_s.values[k]):.6g} m")
         parts += _rated(ds, k)
         if "swing_angle_max" in ds and float(ds.swing_angle_max.values[k]) >= SWING_SAID:
+            above = int(np.isnan(ds.swing_angle.values[:, k]).sum())
             parts.append(f"largest swing angle {_deg(float(ds.swing_angle_max.values[k]))} "
-                         f"deg at t = {float(ds.swing_angle_max_time.values[k]):.6g} s")
+                         f"deg at t = {float(ds.swing_angle_max_time.values[k]):.6g} s"
+                         + (f" (at {above} of {ds.sizes['time']} outputs above its chord more "
+                            "than beside it, where it has no swing: the largest is of the "
+                            "others)" if above else ""))
         if "clearance_time" in ds:
             parts.append(f"least clearance {float(ds.clearance.values[k]):.6g} m at t = "
                          f"{float(ds.clearance_time.values[k]):.6g} s")

@@ -356,3 +356,20 @@ def test_a_tolerance_below_what_atol_allows_is_noted():
     np.testing.assert_array_equal(runs[1e-8].position.values, runs[1e-9].position.values)
     fine = catdae.run(catdae.load_case(plucked(1e-8, 1e-13)))["free"].ds
     assert "times the largest displacement" not in fine.attrs.get("note", "")
+
+
+def test_the_printed_largest_swing_says_when_outputs_had_none():
+    """The violent example whips its cable over its chord: at those outputs the swing is NaN
+    (above the chord more than beside it), and the printed largest swing (134.97°, just under
+    the cut) read as the peak (tester t72). The summary now counts those outputs."""
+    from catdae.output.summary import summary
+
+    from repo_paths import CASES
+
+    text = (CASES / "example2_support_motion_violent.toml").read_text()
+    tree = catdae.run(catdae.load_case(text.replace("duration = 4.0", "duration = 1.2")))
+    ds = tree["excitation"].ds if "excitation" in tree.children else next(
+        tree[n].ds for n in tree.children if tree[n].ds.attrs.get("kind") == "transient")
+    nan = int(np.isnan(ds.swing_angle.values[:, 0]).sum())
+    assert nan > 0
+    assert f"at {nan} of {ds.sizes['time']} outputs above its chord" in summary(tree)
