@@ -304,7 +304,7 @@ def modes(data, n: int = 6) -> Figure:
               else ds["shape"].isel(mode=k))
         mode = int(ds.mode.values[k])
         for cab, nodes in paths.items():
-            x = x_of.sel(node=nodes).values if x_of is not None else ds.s.sel(node=nodes).values
+            x = x_of.sel(node=nodes).values if x_of is not None else _s_along(ds, cab, nodes)
             for a, style in (("y", "--"), ("z", "-")):
                 ax.plot(x, sh.sel(node=nodes, axis=a).values, style, marker=".",
                         label=f"{cab} {a}", gid=f"{mode}|{cab}|{a}")
@@ -321,6 +321,15 @@ def modes(data, n: int = 6) -> Figure:
     axes[-1, 0].set_xlabel(label(x_of, "x") if x_of is not None else label(ds.s, "s"))
     fig.tight_layout()
     return fig
+
+
+def _s_along(ds: xr.Dataset, cab: str, nodes: list[str]) -> np.ndarray:
+    """The unstrained arc length of a cable's nodes along that cable (a shared end node's
+    ``s`` is along the first cable through it; its elements' ``element_s`` are along each)."""
+    if "element_s" not in ds.coords:
+        return ds.s.sel(node=nodes).values
+    es = ds.element_s.values[ds.element_cable.values == cab]
+    return np.concatenate([es[:1, 0], es[:, 1]])
 
 
 def _figure(what: str, ds: xr.Dataset, node, times) -> Figure:

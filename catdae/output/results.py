@@ -136,7 +136,7 @@ def modal_dataset(mesh: Mesh, frequency: np.ndarray, shape: np.ndarray, plane, s
     if asked > n:  # a model with fewer free degrees of freedom than modes asked for
         attrs = {**attrs, "note": f"{asked} modes were asked for and the model has {n} (as "
                  "many as its free degrees of freedom): all of them are given"}
-    coords = _coords(mesh, with_elements=False)
+    coords = _coords(mesh)  # the elements too: the figures draw each cable through its ends
     coords["mode"] = xr.Variable("mode", np.arange(1, n + 1, dtype=np.int32),
                                  {"long_name": "mode number"})
     ds = xr.Dataset(

@@ -225,3 +225,21 @@ def test_figures_and_series_of_a_run_that_did_not_complete_say_so(ex1, tmp_path,
     assert f"<!-- step not completed: {status} -->" in pvd
     done = main(["export", str(ex1[1]), "--vtk", str(tmp_path / "vtk2"), "--step", "release"])
     assert done == 0 and "did not complete" not in capsys.readouterr().err
+
+
+def test_modes_of_a_network_draw_every_cable_through_its_shared_node():
+    """The modal groups held no elements, so the mode figure drew each cable through its own
+    mesh nodes only: a node shared by three cables appeared on the first alone, the others'
+    lines stopping short of it (tester t72). Each cable's line now runs from s = 0 to its
+    length, through the shared node's own shape value."""
+    tree = catdae.run(THREE, progress=False)
+    modal = next(n for n in tree.children if tree[n].ds.attrs.get("kind") == "modal")
+    ds = tree[modal].to_dataset()
+    fig = plot.modes(ds, n=2)
+    case = catdae.load_case(THREE)
+    for cable in case.cables:
+        (line,) = _lines(fig.axes[0], f"1|{cable.name}|z")
+        x, z = line.get_xdata(), line.get_ydata()
+        assert x[0] == 0.0 and x[-1] == pytest.approx(cable.length, rel=1e-12)
+        for end, at in ((cable.ends[0], 0), (cable.ends[1], -1)):
+            assert z[at] == float(ds.shape.isel(mode=0).sel(node=end, axis="z"))
