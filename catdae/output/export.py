@@ -133,9 +133,9 @@ def write_step(ds: xr.Dataset, folder: str | os.PathLike, name: str, case=None) 
 
     if (why := step_problem(ds)) is not None:
         raise ExportError(f"step {name[:60]!r}: {why}")
-    if "element_node" not in ds.coords:
-        raise ExportError(f"step {name!r} has no elements to export (a {ds.attrs.get('kind')} "
-                          "step)")
+    if "element_node" not in ds.coords or ds.attrs.get("kind") not in ("static", "transient"):
+        raise ExportError(f"step {name!r} has no cable positions to export (a "
+                          f"{ds.attrs.get('kind')} step: static and transient steps are)")
     folder = Path(folder)
     sub = folder / name
     sub.mkdir(parents=True, exist_ok=True)

@@ -243,3 +243,14 @@ def test_modes_of_a_network_draw_every_cable_through_its_shared_node():
         assert x[0] == 0.0 and x[-1] == pytest.approx(cable.length, rel=1e-12)
         for end, at in ((cable.ends[0], 0), (cable.ends[1], -1)):
             assert z[at] == float(ds.shape.isel(mode=0).sel(node=end, axis="z"))
+
+
+def test_a_modal_step_named_for_export_is_refused_with_why(tmp_path, capsys):
+    """Modal groups now carry the elements' coordinates (for the mode figure); exporting one
+    by name must still be a clear refusal (exit 2), not a missing-variable traceback."""
+    tree = catdae.run(THREE, progress=False)
+    path = tmp_path / "three.nc"
+    tree.to_netcdf(path)
+    modal = next(n for n in tree.children if tree[n].ds.attrs.get("kind") == "modal")
+    assert main(["export", str(path), "--vtk", str(tmp_path / "v"), "--step", modal]) == 2
+    assert "no cable positions to export (a modal step" in capsys.readouterr().err
