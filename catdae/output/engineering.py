@@ -232,6 +232,8 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
         if "connector_swing_angle" in ds:
             data.update(_extreme(ds.connector_swing_angle, how,
                                  "angle of the connector's axis from the vertical"))
+            data.update(_extreme(ds.connector_force, how, "axial force of the connector "
+                                 "(tension positive)"))
     cables = list(dict.fromkeys(str(c) for c in ds.element_cable.values))
     rated = rated_strengths(case, cables)
     if np.isfinite(rated).any():

@@ -83,6 +83,9 @@ def _connector_lines(ds) -> list[str]:
     out = []
     for k, name in enumerate(ds.connector.values):
         kind = str(ds.connector_kind.values[k])
+        if kind == "damper" and "connector_force_max" in ds:  # a transient: its force range
+            out.append(f"    damper {name}: force {float(ds.connector_force_min.values[k]):.6g}"
+                       f" to {float(ds.connector_force_max.values[k]):.6g} N")
         if kind == "damper":
             continue
         if "time" not in ds.connector_swing_angle.dims:
