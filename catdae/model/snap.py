@@ -148,6 +148,7 @@ def snap_reason(model, step, X: np.ndarray, V: np.ndarray, t0: float,
     if released:
         changed = [*step.add, *step.remove]
         what = (f"{', '.join(repr(c) for c in changed)} added or removed" if changed else
+                "a temperature change" if step.temperature_change is not None else
                 "a release")
         return (f"the step starts out of balance by {force:.3g} N at node "
                 f"{model.mesh.node_names[node]} ({what}; the largest tension is {t_max:.3g} N) "
