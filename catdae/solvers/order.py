@@ -21,10 +21,7 @@ class OrderChoice:
     measured (docs/theory.md §8.6), in steps per simulated second over the second half of a
     *window* of steps of one IDA (a new IDA starts at order 1 with short steps). The run starts
     at order 2 where ω_max / ω₁ > ``START_RATIO`` (it leaves the state free of the fast content
-    that order 5 carries and order 2 must first damp) or where the error test leaves the fast
-    content to BDF's damping (``resolve = "output"``: order 5, which does not damp it, let an
-    unresolved axial ringing of a 20-element jumper's top element read +18 % and -20 % in its
-    tension, in 3.4 times order 2's steps), at order 5 otherwise. After the first
+    that order 5 carries and order 2 must first damp), at order 5 otherwise. After the first
     window the other order runs one window from the current state (a new IDA) and takes over if
     it measures fewer than ``MARGIN`` times the incumbent's steps per second (where it does not,
     the driver takes the trial back and the incumbent's IDA goes on from the trial's start:
@@ -52,15 +49,12 @@ class OrderChoice:
     FIRST_TIME = 0.1  # a first window at order 2 lasts at least this share of 2π/ω₁ ...
     FIRST_MAX = 16  # ... or this many windows of steps, whichever comes first
 
-    def __init__(self, omega_max: float | None, omega_1: float, t_end: float = np.inf,
-                 damps: bool = False):
+    def __init__(self, omega_max: float | None, omega_1: float, t_end: float = np.inf):
         self.t_end = t_end
         self.omega_max = omega_max
         self.omega_1 = omega_1
-        # ``damps``: the error test leaves fast content unresolved (resolve "output") and
-        # relies on BDF to damp it, which the A-stable order 2 does and order 5 does not
-        self.order = 2 if damps or (omega_max is not None
-                                    and omega_max / omega_1 > self.START_RATIO) else 5
+        self.order = 2 if (omega_max is not None
+                           and omega_max / omega_1 > self.START_RATIO) else 5
         self.first = self.order
         self.mode = "first"  # first window; then "trial" of the other order; then "run"
         self.length = self._window(self.order)

@@ -153,8 +153,8 @@ class _Run:
         atol, self.omega_error = error_weights(self.resolve, step.atol, self.omega,
                                                self.dt_out, prob.n)
         self.auto = step.max_order == "auto"
-        self.order_choice = (OrderChoice(highest_frequency(prob, t0, y0), self.omega, self.t_end,
-                                         damps=self.resolve == "output") if self.auto else None)
+        self.order_choice = (OrderChoice(highest_frequency(prob, t0, y0), self.omega,
+                                         self.t_end) if self.auto else None)
         options = dict(rtol=step.rtol, atol=atol,
                        max_order=self.order_choice.order if self.auto else int(step.max_order),
                        max_num_steps=100000, linsolver=self.linsolver)
