@@ -97,6 +97,10 @@ def with_damped_modes(ds: xr.Dataset, modes, shapes: np.ndarray, plane, symmetry
     shape = pad(np.stack([shapes.real, shapes.imag], axis=1))  # (n, 2, n_nodes, 3)
     labels = ["overdamped or not found"] * n
     ds = with_note(ds, getattr(modes, "note", ""))
+    if k < n:  # a mode without oscillation has a real eigenvalue: no frequency, no ζ < 1
+        ds = with_note(ds, f"{n - k} of the {n} modes asked for are overdamped (damped beyond "
+                       "critical: they decay without oscillating) or were not found: their "
+                       "damped results are NaN, labelled so")
     return ds.assign(
         undamped_mode=var("mode", like_undamped(ds["shape"].values, shapes, n), "1",
                           "number of the undamped mode the damped mode is most like (MAC); "

@@ -162,6 +162,9 @@ def test_a_damped_modal_step_whose_every_mode_is_overdamped_is_written():
     zeta = md.damping_ratio.sel(mode=1).values
     assert zeta[0] == pytest.approx(10.0 / (2 * np.sqrt(1000.0 * 4.0)), rel=1e-10)
     assert np.isnan(zeta[1]) and np.isnan(md.frequency.sel(mode=1).values[1])
+    # and the note of that value says so (tester t68: NaN with no word)
+    notes = str(md.attrs.get("note", "")).split(" | ")
+    assert "overdamped" not in notes[0] and "1 of the 1 modes asked for are overdamped" in notes[1]
 
 
 def test_a_modal_step_after_a_load_sweep_is_about_its_own_equilibrium():
