@@ -46,8 +46,9 @@ def with_connector_forces(ds: xr.Dataset, connectors, X: np.ndarray,
 
 def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarray:
     """For each damped mode (complex shapes (k, n_nodes, 3)), the number (from 1) of the
-    undamped mode (real shapes (n, n_nodes, 3)) of largest modal assurance criterion
-    |uᵀ φ|² / (|u|² |φ|²); 0 beyond the k found. Damped modes are sorted by |s| and the
+    undamped mode (real shapes (n, n_nodes, 3)) paired with it one to one on the modal
+    assurance criterion |uᵀ φ|² / (|u|² |φ|²) (the pairs of largest total); 0 beyond the k
+    found. Damped modes are sorted by |s| and the
     overdamped ones dropped, so the k-th damped mode need not be the k-th undamped one."""
     out = np.zeros(n, dtype=np.int32)
     if damped.shape[0] == 0 or undamped.shape[0] == 0:  # none found underdamped
@@ -57,7 +58,12 @@ def like_undamped(undamped: np.ndarray, damped: np.ndarray, n: int) -> np.ndarra
     num = np.abs(d.conj() @ u.T) ** 2
     den = np.outer(np.einsum("ij,ij->i", d.conj(), d).real, np.einsum("ij,ij->i", u, u))
     mac = num / np.where(den > 0, den, 1.0)
-    out[:d.shape[0]] = np.argmax(mac, axis=1) + 1
+    # one to one (Hungarian): two stays joined by a strong damper have damped modes that mix
+    # undamped ones, and the largest criterion of each mapped two of them to one mode (t68)
+    from scipy.optimize import linear_sum_assignment
+
+    rows, cols = linear_sum_assignment(-mac)
+    out[rows] = cols + 1
     return out
 
 

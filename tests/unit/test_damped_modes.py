@@ -54,3 +54,31 @@ def test_rayleigh_damping_gives_the_closed_form_ratios(capsys):
     lines = summary(catdae.run(case_from_dict(tomllib.loads(text)))).splitlines()
     first = next(x for x in lines if "mode 1:" in x)
     assert "Hz" in first and "damping ratio" in first and "plane" in first, lines
+
+
+def test_damped_modes_are_paired_with_undamped_ones_one_to_one():
+    """Two stays of different tension joined by a strong damper mix their undamped modes;
+    pairing each damped mode with its largest modal assurance criterion mapped two of them to
+    one undamped mode (tester t68: damped modes 6 and 8 both 'like undamped mode 8'). The
+    pairing is one to one, and where a damped mode is an undamped one untouched (the
+    damper's point at rest in it: ζ = 0, same frequency) it is paired with that one."""
+    text = ('title = "two stays and a damper tie"\n[materials.strand]\nEA = 2.0e9\n'
+            'mass = 60.0\n[nodes]\nA1 = [0.0, 0.0, 0.0]\nB1 = [150.0, 0.0, 0.0]\n'
+            'A2 = [0.0, 2.0, 0.21875332]\nB2 = [150.0, 2.0, 0.21875332]\n[supports]\n'
+            'A1 = "pinned"\nB1 = "pinned"\nA2 = "pinned"\nB2 = "pinned"\n'
+            '[[cables]]\nname = "s1"\nends = ["A1", "B1"]\nmaterial = "strand"\n'
+            'form = { pretension = 4.0e6 }\nelements = 40\n'
+            '[[cables]]\nname = "s2"\nends = ["A2", "B2"]\nmaterial = "strand"\n'
+            'form = { pretension = 2.5e6 }\nelements = 40\n'
+            '[[dampers]]\nname = "tie"\nends = ["s1.16", "s2.16"]\ncoefficient = 5.0e4\n'
+            '[[steps]]\nkind = "static"\nname = "st"\n'
+            '[[steps]]\nkind = "modal"\nname = "modes"\nmodes = 12\n')
+    ds = catdae.run(catdae.load_case(text))["modes"].ds
+    like = ds.undamped_mode.values
+    found = like[like > 0]
+    assert len(set(found.tolist())) == found.size, like
+    untouched = np.flatnonzero(np.abs(ds.damping_ratio.values) < 1e-9)
+    assert untouched.size >= 2
+    for k in untouched:
+        f_u = float(ds.undamped_frequency.sel(mode=int(like[k])))
+        assert float(ds.frequency.values[k]) == pytest.approx(f_u, rel=1e-6), k
