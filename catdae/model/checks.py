@@ -87,26 +87,22 @@ def _unheld_parts(case: Case, mesh) -> list[tuple[str, str]]:
     transient alone may let a part fall on purpose; a seabed may hold what rests on it."""
     if case.seabed is not None or not any(s.kind in ("static", "modal") for s in case.steps):
         return []
-    parent = list(range(mesh.n_nodes))
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
 
-    def root(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    pairs = [tuple(e) for e in mesh.conn]
-    pairs += [tuple(mesh.node_index(e) for e in c.ends) for c in (*case.springs, *case.bars)]
-    for a, b in pairs:
-        parent[root(int(a))] = root(int(b))
-    held = {root(mesh.node_index(n)) for n, axes in case.supports.items() if axes}
+    joins = [[mesh.node_index(e) for e in c.ends] for c in (*case.springs, *case.bars)]
+    pairs = np.vstack([mesh.conn, np.array(joins, np.int64).reshape(-1, 2)])
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
+                       shape=(mesh.n_nodes, mesh.n_nodes))
+    part_of = connected_components(graph, directed=False)[1]
+    held = {int(part_of[mesh.node_index(n)]) for n, axes in case.supports.items() if axes}
     out = []
     for i, c in enumerate(case.cables):
-        part = root(mesh.node_index(c.ends[0]))
+        part = int(part_of[mesh.node_index(c.ends[0])])
         if part in held:
             continue
         held.add(part)  # say it once per part
-        names = [x.name for x in case.cables if root(mesh.node_index(x.ends[0])) == part]
+        names = [x.name for x in case.cables if part_of[mesh.node_index(x.ends[0])] == part]
         shown = ", ".join(repr(n) for n in names[:5]) + (
             f" and {len(names) - 5} more" if len(names) > 5 else "")
         out.append((f"cables[{i}]", f"cable{'s' if len(names) > 1 else ''} {shown}: no support "

@@ -67,11 +67,12 @@ def _balance(model, prob, rec, n_valid: int):
     return t, dE - W - Ws, Us, moved
 
 
-def energy_gain(model, prob, rec, n_valid: int):
+def energy_gain(model, prob, rec, n_valid: int, found=False):
     """(gain J, energy moved J, first time s the gain passed the limit, its limit J), or None
-    when the balance cannot be closed at the outputs (:func:`_balance`) or no energy was
-    gained beyond the limit."""
-    found = _balance(model, prob, rec, n_valid)
+    when the balance cannot be closed at the outputs (:func:`_balance`, or ``found``, its
+    result when already computed) or no energy was gained beyond the limit."""
+    if found is False:
+        found = _balance(model, prob, rec, n_valid)
     if found is None:
         return None
     t, balance, Us, moved = found
@@ -84,17 +85,16 @@ def energy_gain(model, prob, rec, n_valid: int):
     return gain, moved, first, limit
 
 
-def loss_note(model, prob, rec, n_valid: int) -> str:
+def loss_note(model, prob, found) -> str:
     """A word when a scene with nothing to take energy out (no damping of any kind, no fluid,
     seabed or damper) lost more than LOSS_LIMIT of the energy moved: the BDF's own damping at
     the step's tolerances (an undamped pendulum at rtol 1e-2 lost 83 % of its energy and half
-    its swing, reported "completed" with no word)."""
+    its swing, reported "completed" with no word). ``found``: :func:`_balance`'s result."""
     cn = model.connectors
     if (prob.damping.damped or prob.axial is not None or model.fluid is not None
             or getattr(prob, "seabed", None) is not None
             or (cn is not None and np.any(cn.coefficient > 0))):
         return ""
-    found = _balance(model, prob, rec, n_valid)
     if found is None:
         return ""
     t, balance, Us, moved = found
@@ -108,12 +108,20 @@ def loss_note(model, prob, rec, n_valid: int) -> str:
             "matters (docs/theory.md §13.6)")
 
 
-def gain_note(model, prob, rec, n_valid: int) -> str:
+def balance_notes(model, prob, rec, n_valid: int) -> str:
+    """The notes on an energy gain and on a loss where nothing dissipates ("" when the
+    balance closes or cannot be closed), from one computation of the balance."""
+    found = _balance(model, prob, rec, n_valid)
+    return "; ".join(n for n in (gain_note(model, prob, rec, n_valid, found),
+                                 loss_note(model, prob, found)) if n)
+
+
+def gain_note(model, prob, rec, n_valid: int, found=False) -> str:
     """The note on an energy gain ("" when the balance closes or cannot be closed)."""
-    found = energy_gain(model, prob, rec, n_valid)
-    if found is None:
+    gained = energy_gain(model, prob, rec, n_valid, found)
+    if gained is None:
         return ""
-    gain, moved, first, _ = found
+    gain, moved, first, _ = gained
     return (f"the energy balance does not close: the run gained {gain:.3g} J that no force "
             f"supplied ({gain / moved:.2g} of {moved:.3g} J, the energy that the supports "
             "and the fluid moved plus the line's largest kinetic and strain energies; past "

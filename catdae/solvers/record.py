@@ -10,7 +10,7 @@ import numpy as np
 from catdae.model.assembly import Model
 from catdae.model.fluid import plausibility_note
 from catdae.solvers.deferred import GAUSS8, DeferredOutputs, can_defer
-from catdae.solvers.energy_check import gain_note, loss_note
+from catdae.solvers.energy_check import balance_notes
 from catdae.solvers.envelope import TensionEnvelope
 from catdae.solvers.fluid_work import FluidWork
 
@@ -109,8 +109,7 @@ def note(model: Model, prob, rec: OutputRecord | None = None, n_valid: int = 0) 
     """Advice on the result's accuracy that the run itself found ("" when none): on the mass
     model, and (given the record and its ``n_valid`` outputs) an energy balance that does not
     close (catdae/solvers/energy_check.py)."""
-    advice = [_mass_note(model, prob), gain_note(model, prob, rec, n_valid),
-              loss_note(model, prob, rec, n_valid),
+    advice = [_mass_note(model, prob), balance_notes(model, prob, rec, n_valid),
               _slack_note(model, rec, n_valid), plausibility_note(model.case),
               _tolerance_note(model, prob, rec, n_valid)]
     return "; ".join(a for a in advice if a)
