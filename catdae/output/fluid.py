@@ -46,11 +46,15 @@ def with_static_fluid(ds: xr.Dataset, fluid: Fluid | None, X: np.ndarray, t: flo
 
 EFFECTIVE = ("effective tension, as everywhere in water: the wall tension is T_wall = T - p A, "
              "p the water pressure at that depth (docs/case-format.md, Effective tension)")
+EFFECTIVE_REACTION = ("in water, the force of the effective tension at the support: the line's "
+                      "wall force on it differs by p A along the line there, p the water "
+                      "pressure at that depth (docs/case-format.md, Effective tension)")
 
 
 def effective_tension(ds: xr.Dataset, in_water: bool) -> xr.Dataset:
     """``ds`` with its tensions (N) named effective where the case has water: the catenary of
-    the submerged weight carries the effective tension, not the wall tension (theory §13.1)."""
+    the submerged weight carries the effective tension, not the wall tension (theory §13.1);
+    its reactions (N) say they are the effective tension's force."""
     if not in_water:
         return ds
     out = ds.copy()
@@ -60,4 +64,6 @@ def effective_tension(ds: xr.Dataset, in_water: bool) -> xr.Dataset:
             text = (text.replace("cable tension", "effective cable tension", 1)
                     if "cable tension" in text else text.replace("tension", "effective tension", 1))
             out[name].attrs.update(long_name=text, comment=EFFECTIVE)
+        elif str(name).startswith("reaction") and v.attrs.get("units") == "N":
+            out[name].attrs.update(comment=EFFECTIVE_REACTION)
     return out

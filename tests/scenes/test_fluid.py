@@ -530,6 +530,18 @@ def test_tensions_in_water_are_named_effective():
     assert tree["waves"].ds.tension_max.attrs["long_name"].startswith("largest effective")
     dry = catdae.run(load_case(_riser(water=False)))
     assert "effective" not in dry["still"].ds.tension.attrs["long_name"]
+    assert "comment" not in dry["still"].ds.reaction.attrs
+
+
+def test_reactions_in_water_are_those_of_the_effective_tension():
+    """The supports' reactions in water balance the submerged weight (weight less buoyancy of
+    the 0.5 m riser, 57.99 m long), as the effective tension's catenary carries it, and say
+    so: the wall force on a support differs by p A along the line."""
+    still = catdae.run(load_case(_riser()))["still"].ds
+    submerged = (300.0 - 1025.0 * math.pi * 0.5**2 / 4) * 57.99 * G
+    assert float(still.reaction.sel(axis="z").sum()) == pytest.approx(submerged, rel=1e-9)
+    for ds in (still, catdae.run(load_case(_riser()))["waves"].ds):
+        assert "p A along the line" in ds.reaction.attrs["comment"]
 
 
 def test_the_fast_current_note_counts_the_current_time_function():
