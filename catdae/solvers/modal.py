@@ -47,7 +47,7 @@ def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) 
         try:
             lam, vec = sla.eigh(kd, md, subset_by_index=[0, n_modes - 1])
         except np.linalg.LinAlgError:  # M singular: massless dofs (a cable of zero mass)
-            lam, vec = _reciprocal(kd, md, n_modes)
+            lam, vec = _reciprocal(kd, md, n_modes, _loose_massless(model, kd, md))
             n_modes = lam.size
         solver = "dense"
     else:
@@ -74,10 +74,34 @@ def solve_modal(model: Model, X: np.ndarray, state: ElementState, n_modes: int) 
     return ModalSolution(freq, shapes, plane, symmetry, solver)
 
 
-def _reciprocal(k: np.ndarray, m: np.ndarray, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+def _loose_massless(model: Model, k: np.ndarray, m: np.ndarray) -> list[str]:
+    """The free nodes without mass that some direction of motion leaves without stiffness
+    (null vectors of K over the massless dofs): a node held only by one spring or bar, which
+    acts along its line alone (at zero force it has no stiffness across it)."""
+    dofs = np.flatnonzero(np.diag(m) <= 0.0)
+    if dofs.size == 0:
+        return []
+    kk = k[np.ix_(dofs, dofs)]
+    lam, vec = np.linalg.eigh(kk)
+    null = vec[:, lam <= 1e-10 * max(float(np.abs(lam).max()), 1e-300)]
+    hit = dofs[np.abs(null).max(axis=1) > 1e-6] if null.size else dofs[:0]
+    nodes = sorted(set((model.free[hit] // 3).tolist()))
+    return [model.mesh.node_names[n] for n in nodes]
+
+
+def _reciprocal(k: np.ndarray, m: np.ndarray, n_modes: int,
+                loose: list[str] = ()) -> tuple[np.ndarray, np.ndarray]:
     """Lowest modes when M is only semi-definite: M φ = μ K φ with μ = 1/ω² (K must be positive
     definite, as it is about a stable state). Massless dofs give μ = 0 (infinite frequency) and
-    are left out, so fewer than n_modes modes may come back."""
+    are left out, so fewer than n_modes modes may come back. ``loose``: the massless nodes
+    that lack stiffness in some direction (named when K is singular)."""
+    if loose:
+        shown = ", ".join(loose[:5]) + (f" and {len(loose) - 5} more" if len(loose) > 5 else "")
+        raise ConvergenceError(
+            f"modal step: free node(s) {shown} have no mass and no stiffness in some direction "
+            "about this state (a spring or a bar acts along its line only; at zero force it "
+            "has no stiffness across it), so they have no motion of their own: put a point "
+            "mass there, join them in more directions, or support them")
     try:
         mu, vec = sla.eigh(m, k)
     except np.linalg.LinAlgError as exc:

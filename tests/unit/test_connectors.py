@@ -195,6 +195,30 @@ def test_a_node_held_by_a_damper_alone_is_refused_before_any_work(tmp_path, caps
     assert main(["check", str(f)]) == 0
 
 
+def test_a_massless_node_on_one_spring_is_named_by_the_modal_step(tmp_path, capsys):
+    """A massless free node F hung from the cable by one spring at zero force has stiffness
+    along the spring only; the modal step said "the static state is not stable", naming
+    nothing (tester t68). It names F; three springs along x, y and z hold it in every
+    direction, and it is condensed out (massless, infinitely stiff in frequency)."""
+    from catdae.cli import main
+
+    def scene(extra):
+        return cable_scene(B=(10.0, 0.0, 0.0), L0=10.3, EA=1e5, mass=1.0, elements=4,
+                           nodes={"F": (5.0, 2.0, -1.0), "G1": (6.0, 2.0, -1.0),
+                                  "G2": (5.0, 3.0, -1.0), "G3": (5.0, 2.0, -2.0)},
+                           supports=("A", "B", "G1", "G2", "G3"), extra=extra,
+                           steps=static_step("st") + step("modal", "m", modes=3))
+
+    f = tmp_path / "one_way.toml"
+    f.write_text(scene(spring("k", ["c.2", "F"], 100.0)))
+    assert main(["run", str(f), "-o", str(tmp_path / "o.nc")]) == 1
+    err = capsys.readouterr().err
+    assert "free node(s) F have no mass and no stiffness in some direction" in err, err
+    f.write_text(scene("".join(spring(f"k{i}", [g, "F"], 100.0)
+                               for i, g in enumerate(("G1", "G2", "G3")))))
+    assert main(["run", str(f), "-o", str(tmp_path / "o2.nc")]) == 0
+
+
 def test_a_part_no_support_holds_is_refused_before_any_work(tmp_path, capsys):
     """A tester's second cable C-D touching nothing: check said valid, the static step ran
     200 Newton iterations ("ramped up to 0 %") and the modal step said "not stable", naming
