@@ -39,6 +39,14 @@ def uniform_temperature(ds: xr.Dataset) -> float | None:
     return float(t.values[0])
 
 
+def _label(name: str, ds: xr.Dataset, temperature: float | None) -> str:
+    """A static step's tick: its name, or a swept step's name and value (``ice: ice_thickness =
+    0.01``, not ``ice-sweep1``), with its temperature."""
+    value = ds.attrs.get("sweep_value")
+    text = f"{name.rsplit('-sweep', 1)[0]}: {value}" if value else name
+    return text if temperature is None else f"{text} ({temperature:g}°)"
+
+
 def spans(tree: xr.DataTree, steps=None) -> Figure:
     """Sag at midspan and at the lowest point (above), the largest tension as a percentage of
     the rated strength, or else the horizontal tension along the chord (below), per cable,
@@ -73,8 +81,8 @@ def spans(tree: xr.DataTree, steps=None) -> Figure:
     if by_temperature:
         ax_t.set_xlabel("temperature (the case's reference_temperature units)")
     else:
-        ax_t.set_xticks(x, [name if t is None else f"{name} ({t:g}°)"
-                            for (name, _), t in zip(groups, temps, strict=True)], rotation=30)
+        ax_t.set_xticks(x, [_label(name, ds, t) for (name, ds), t in
+                            zip(groups, temps, strict=True)], rotation=30)
         ax_t.set_xlabel("static step")
     for ax in (ax_s, ax_t):
         ax.grid(True, alpha=0.3)

@@ -270,3 +270,24 @@ def test_a_cable_past_its_rated_strength_or_below_the_ground_is_noted(rated, gro
     assert (f"at {pct:.4g} % of its rated strength" in note) == (pct > 100.0)
     assert (f"passes {-gap:.4g} m below the ground" in note) == (gap < 0.0)
     assert (pct > 100.0 and gap < 0.0) == (rated < 1e4), (pct, gap)
+
+
+def test_a_swept_static_step_is_labelled_by_its_values_in_the_spans_figure():
+    """A load_factor sweep of the ice load (no temperature): the figure is drawn against the
+    steps, and each swept point's tick says its step and value, not its index ("iced-sweep1");
+    the sags are Irvine's level span's under the self-weight and that share of the ice."""
+    def text(factors):
+        sweep = "sweep = { field = \"load_factor\", values = %s }\n" % factors
+        return cable_scene(B=(300.0, 0.0, 0.0), L0=301.0, EA=3.0e7, mass=1.6, elements=8,
+                           extra='[[distributed_loads]]\ncable = "c"\nload = [0.0, 0.0, -15.0]\n'
+                                 'name = "ice"\n',
+                           steps='[[steps]]\nkind = "static"\nname = "iced"\n' + sweep)
+
+    tree = catdae.run(catdae.load_case(text([0.5, 1.0])))
+    fig = plot_spans.spans(tree)
+    ticks = [t.get_text() for t in fig.axes[1].get_xticklabels()]
+    assert ticks == ["iced: load_factor = 0.5", "iced: load_factor = 1"], ticks
+    drawn = {ln.get_gid(): ln for ax in fig.axes for ln in ax.get_lines()}
+    exact = [level_span(301.0, 3.0e7, 1.6 * G + 15.0 * f, 0.0, 300.0)[0] for f in (0.5, 1.0)]
+    # the ice as loads at Gauss points converges as h² to Irvine's (2.3e-4 at 8 elements)
+    np.testing.assert_allclose(drawn["c|sag_midspan"].get_ydata(), exact, rtol=5e-4)
