@@ -277,7 +277,7 @@ def test_a_swept_static_step_is_labelled_by_its_values_in_the_spans_figure():
     steps, and each swept point's tick says its step and value, not its index ("iced-sweep1");
     the sags are Irvine's level span's under the self-weight and that share of the ice."""
     def text(factors):
-        sweep = "sweep = { field = \"load_factor\", values = %s }\n" % factors
+        sweep = f'sweep = {{ field = "load_factor", values = {factors} }}\n'
         return cable_scene(B=(300.0, 0.0, 0.0), L0=301.0, EA=3.0e7, mass=1.6, elements=8,
                            extra='[[distributed_loads]]\ncable = "c"\nload = [0.0, 0.0, -15.0]\n'
                                  'name = "ice"\n',
