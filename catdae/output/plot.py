@@ -206,9 +206,16 @@ def history(data, node: str | None = None) -> Figure:
     node = _node(ds, node)
     d = ds.displacement.sel(node=node)
     fig, axes = _subplots(3, 1, figsize=(8, 7), sharex=True)
+    big = float(np.nanmax(np.ptp(d.values, axis=0))) if d.size else 0.0
     for ax, a in zip(axes, ds.axis.values, strict=True):
-        ax.plot(ds.time.values, d.sel(axis=a).values, gid=f"{node}|{a}")
-        mark_peaks(ax, ds, "displacement", node, str(a))  # the envelope, when stored
+        y = d.sel(axis=a).values
+        ax.plot(ds.time.values, y, gid=f"{node}|{a}")
+        if np.nanmax(y) - np.nanmin(y) > 1e-9 * big:
+            mark_peaks(ax, ds, "displacement", node, str(a))  # the envelope, when stored
+        else:  # rounding, not motion: not drawn magnified to fill the panel
+            ax.set_ylim(np.nanmean(y) - max(big, 1e-3) / 2, np.nanmean(y) + max(big, 1e-3) / 2)
+            ax.text(0.5, 0.5, f"no motion along {a} (within rounding)", ha="center",
+                    va="center", transform=ax.transAxes, color="0.4")
         ax.set_ylabel(label(ds.displacement, f"{a}"))
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel(label(ds.time, "time"))
