@@ -48,7 +48,7 @@ def _step_lines(name: str, ds) -> list[str]:
 
 
 def _transient_lines(name: str, ds) -> list[str]:
-    """The transient's run and the largest motion of a free node during it."""
+    """The transient's run and the largest distance a free node moves from its start."""
     a = ds.attrs
     lines = [f"[{name}] transient: {ds.time.size} outputs to t = "
              f"{float(ds.time[-1]):.4g} s, {a.get('n_steps')} steps, "
@@ -64,8 +64,8 @@ def _transient_lines(name: str, ds) -> list[str]:
     tmax = ds.tension_max if "tension_max" in ds else ds.get("tension")  # envelope
     top = (f"; max tension {float(tmax.max()):.6g} N" if ds.sizes.get("element")
            and tmax is not None else "")  # a scene of connectors alone has no element
-    lines.append(f"    largest motion of a free node during the step at {node}: "
-                 f"{float(mag.sel(node=node).max()):.4g} m{top}")
+    lines.append(f"    largest distance of a free node from its place at the step's start: "
+                 f"{float(mag.sel(node=node).max()):.4g} m, at {node}{top}")
     return lines
 
 
