@@ -124,17 +124,24 @@ def _one_cable(model, X, state, els, s, p) -> dict[str, float]:
                 lateral = d[:2]  # (round-off read as 180° of swing, "sag -2.2e-16 m")
             out["sag_midspan"] = float(d[2])
             out["swing_angle"] = float(np.degrees(np.arctan2(np.linalg.norm(lateral), d[2])))
-    # the lowest point, refined within a sample of the lowest sample
+    # the lowest point, refined within a sample of the lowest sample; at a node, on both of
+    # its elements (a point load's kink just inside the other one is lower than the node)
     z = p[..., 2]
     m, j = np.unravel_index(int(np.argmin(z)), z.shape)
-    e = int(els[m])
-    xi = X[mesh.conn[e, 0]]
     n_s = s.shape[1]
-    bx, bf = minimize_bounded(lambda v: float(xi[2] + _point(model, state, e, v)[2]),
-                              s[e, max(j - 1, 0)], s[e, min(j + 1, n_s - 1)],
-                              xatol=1e-11 * mesh.L0[e])
-    s_low, z_low = ((float(bx), float(bf)) if bf < z[m, j]
-                    else (float(s[e, j]), float(z[m, j])))
+    near = [(m, j)] + ([(m - 1, n_s - 1)] if j == 0 and m > 0 else []) + (
+        [(m + 1, 0)] if j == n_s - 1 and m + 1 < len(els) else [])
+    best = (float(z[m, j]), int(els[m]), float(s[els[m], j]))
+    for mm, jj in near:
+        e = int(els[mm])
+        xi = X[mesh.conn[e, 0]]
+        bx, bf = minimize_bounded(lambda v, e=e, xi=xi: float(xi[2] + _point(model, state, e,
+                                                                               v)[2]),
+                                  s[e, max(jj - 1, 0)], s[e, min(jj + 1, n_s - 1)],
+                                  xatol=1e-11 * mesh.L0[e])
+        if bf < best[0]:
+            best = (float(bf), e, float(bx))
+    z_low, e, s_low = best
     out["lowest_point_elevation"] = z_low
     out["lowest_point_s"] = (mesh.s_start[e] + s_low) / mesh.thermal[e]
     out["sag_lowest_point"] = max(min(a[2], b[2]) - z_low, 0.0)

@@ -104,6 +104,30 @@ def test_point_load_or_mass_inside_element_matches_two_segment_catenary(ne, what
                                atol=1e-6)
 
 
+@pytest.mark.parametrize(("ne", "s1"), [(3, 53.3), (4, 39.9), (4, 40.1)])
+def test_the_lowest_point_is_a_kink_just_beside_a_node(ne, s1):
+    """A 20 kN load 0.03-0.1 m from a node (tester t74): the cable's lowest point is the kink
+    under the load; `sag_lowest_point` read the node's height (1-2.8 cm high), the search
+    refining only the element of the node's sample. Against two catenary segments."""
+    L0, EA, m, F, span, rise = 160.0, 2.0e7, 8.0, 2.0e4, 150.0, 30.0
+    extra = load("P", [0.0, 0.0, -F], cable="c", s=s1)
+    ds = catdae.run(single_span((span, 0.0, rise), L0, EA, m, ne, extra))["st"].ds
+    w = m * G
+
+    def resid(p):
+        H, V = p
+        dx1, dz1 = _segment(H, V, s1, w, EA)
+        dx2, dz2 = _segment(H, V + w * s1 + F, L0 - s1, w, EA)
+        return [dx1 + dx2 - span, dz1 + dz2 - rise]
+
+    H, V = fsolve(resid, [3.0e4, -2.0e4], xtol=1e-14)
+    kink = float(_segment(H, V, s1, w, EA)[1])
+    assert kink < -12.0  # the kink is the lowest point (below A and the rest)
+    assert float(ds.lowest_point_elevation.item()) == pytest.approx(kink, abs=1e-8)
+    assert float(ds.sag_lowest_point.item()) == pytest.approx(-kink, abs=1e-8)
+    assert float(ds.lowest_point_s.item()) == pytest.approx(s1, abs=1e-6)
+
+
 def test_roller_support_pulled_horizontally_carries_exactly_the_pull():
     # B slides freely along x and is pulled by 2000 N: H = 2000 N, span from Irvine
     L0, EA, m = 10.0, 1.0e6, 2.0
