@@ -327,16 +327,18 @@ class ContactModel(Model):
 
     def summary(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Per cable, at node resolution: unstrained length resting on the seabed (elements
-        with both nodes in contact, half of those with one) and the touchdown point (the last
+        with both nodes in contact, half of those with one; :func:`ends_on_seabed`) and the
+        touchdown point (the last
         node in contact seen from the cable's upper end, where the suspended part that reaches
         it leaves the seabed; catdae.solvers.seabed_static.seabed_summary)."""
         mesh = self.mesh
         nc = len(mesh.cable_names)
         on = np.zeros(mesh.n_nodes, bool)
         on[self.contact.nodes] = X[self.contact.nodes, 2] < self.contact.zb
-        on |= self.fixed_mask[:, 2] & (X[:, 2] <= self.contact.zb + 1e-9)
-        n_on = on[mesh.conn].sum(axis=1)
+        anchor = self.fixed_mask[:, 2] & (X[:, 2] <= self.contact.zb + 1e-9)
+        n_on = ends_on_seabed(on & ~anchor, anchor, mesh.conn)
         length = np.bincount(mesh.cable_of_element, weights=0.5 * n_on * mesh.L0, minlength=nc)
+        on &= ~anchor  # the touchdown is a free node's (an anchor alone: lifted off)
         touchdown = np.full((nc, 3), np.nan)
         for ci in range(nc):
             els = np.flatnonzero(mesh.cable_of_element == ci)
@@ -349,3 +351,14 @@ class ContactModel(Model):
                         touchdown[ci] = X[a] if on[a] else X[b]
                     break
         return {"seabed_length": length, "touchdown": touchdown}
+
+
+def ends_on_seabed(free_on: np.ndarray, anchor: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """(..., n_elem) how many of each element's two ends lie on the seabed: free nodes in
+    contact (``free_on``, (..., n_nodes)), and a support at the seabed (``anchor``) only where
+    the element's other end lies too: a line lifted off at its anchor has nothing on the
+    seabed (a sitting anchor counted half an element laid and the touchdown there; tester
+    t76), a line lying up to it has its last element whole."""
+    a, b = conn[:, 0], conn[:, 1]
+    fa, fb = free_on[..., a], free_on[..., b]
+    return (fa.astype(int) + fb + (anchor[..., a] & fb) + (anchor[..., b] & fa))

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
+from catdae.model.seabed import ends_on_seabed
 from catdae.output.results import label, var
 
 
@@ -67,8 +68,9 @@ def sag_into_seabed(ds: xr.Dataset, mesh, zb: float) -> str:
 
 def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Dataset:
     """A transient group with ``seabed_length``(time, cable) and ``touchdown``(time, cable,
-    axis) at node resolution, from the node positions: nodes at or below the seabed are in
-    contact; an element counts whole with both nodes in contact, half with one; the touchdown
+    axis) at node resolution, from the node positions: free nodes at or below the seabed are in
+    contact; an element counts whole with both ends in contact, half with one (a support at
+    the seabed only with its neighbour: catdae.model.seabed.ends_on_seabed); the touchdown
     is the last node in contact seen from the cable's upper end (the higher end at that time;
     NaN when that end itself rests on the seabed), as in the static groups."""
     if "position" not in ds or "time" not in ds.dims:
@@ -76,7 +78,10 @@ def add_seabed_history(ds: xr.Dataset, mesh, zb: float, contact=None) -> xr.Data
     z = ds.position.sel(axis="z").transpose("time", "node").values  # (nt, n_nodes)
     order = [list(ds.node.values).index(n) for n in mesh.node_names]
     on = z[:, order] <= zb + 1e-9 * max(1.0, abs(zb))  # (nt, n_nodes) in mesh order
-    n_on = on[:, mesh.conn].sum(axis=2)  # (nt, n_elem)
+    held = ~np.isnan(ds.reaction.sel(axis="z").transpose("time", "node").values[:, order])
+    anchor = on & held  # supports at the seabed: laid only with their neighbour
+    on &= ~held
+    n_on = ends_on_seabed(on, anchor, mesh.conn)  # (nt, n_elem)
     nc = len(mesh.cable_names)
     length = np.stack([(0.5 * n_on[:, mesh.cable_of_element == c] *
                         mesh.L0[mesh.cable_of_element == c]).sum(axis=1) for c in range(nc)],

@@ -169,3 +169,31 @@ def test_bundled_mooring_case_statics_and_a_cheap_run():
     lying_static = float(st.seabed_length.item())
     assert np.all(np.abs(tr.seabed_length.values - lying_static) <= 3 * 38.0)
     assert np.all(np.isfinite(tr.touchdown.values))
+
+
+@pytest.mark.parametrize("B, lies", [((40.0, 5.0, -10.0), True), ((59.0, 5.0, -10.0), False)])
+def test_an_anchor_on_the_seabed_lays_nothing_where_the_line_lifts_off_there(B, lies):
+    """On the contact springs an anchor sitting at the seabed counted as lying: a line lifted
+    off all along read half an element on the seabed and its touchdown at the anchor, never 0
+    and NaN (tester t76, against MoorDyn and the rigid seabed). Where the line leaves the
+    anchor rising (chord 60.05 m of a 60 m line: every free node above the seabed), nothing lies, in
+    the static group and over a transient; where it lies (40 m away), the anchor's element
+    counts whole and the touchdown is a free node below the seabed."""
+    text = _line({"stiffness": 1.0e5},
+                 step("static", "st") + step("transient", "tr", duration=0.5,
+                                              output_interval=0.1, mass_model="lumped"), B=B)
+    tree = catdae.run(load_case(text), progress=False)
+    st, tr = tree["st"].to_dataset(), tree["tr"].to_dataset()
+    free_z = st.position.sel(axis="z", node=[f"c.{k}" for k in range(1, 8)]).values
+    if not lies:
+        assert free_z.min() > -20.0  # lifted all along (independent of the rule)
+        assert float(st.seabed_length.item()) == 0.0
+        assert np.isnan(st.touchdown.values).all()
+        assert np.all(tr.seabed_length.values == 0.0) and np.isnan(tr.touchdown.values).all()
+        return
+    below = free_z < -20.0
+    assert below[0] and not below.all()  # lying from the anchor, then rising
+    k = int(np.argmin(below))  # the first free node above: the touchdown is the one before
+    assert float(st.seabed_length.item()) == pytest.approx(7.5 * (k + 0.5), rel=1e-12)
+    np.testing.assert_allclose(st.touchdown.values.ravel(),
+                               st.position.sel(node=f"c.{k}").values)
