@@ -96,8 +96,8 @@ def _why(model: Model, rec, lam2: np.ndarray, taut_at: np.ndarray) -> str:
                 f"{model.mesh.element_names[e]}: λ² {lam2[e]:.3g} at the start, tension "
                 f"{t_max[e]:.4g} N at t = {when:.6g} s, past {taut_at[e]:.4g} N, where λ² is 1 "
                 f"and at least {RISE:g} times its start): a sagging line pulled taut takes "
-                "chord changes by stretch, as a snap does, whose axial waves the catenary mass "
-                "does not carry")
+                "chord changes by stretch, whose axial waves the catenary mass does not "
+                "carry")
     slack = slack_where(model, rec, rec.n_valid)
     if slack:  # a taut line that went slack (or into compression) and snapped taut
         return f"in a first run with the {mm} mass, {slack}"

@@ -137,6 +137,8 @@ def test_a_smooth_drive_that_pulls_the_sagging_line_taut_is_run_again_lumped():
     assert ds.attrs["mass_model"] == "lumped"
     choice = ds.attrs["mass_model_choice"]
     assert "pulled sagging elements taut" in choice and "steps discarded" in choice, choice
+    # the advice saves the first run (blended was not the answer here; tester t76)
+    assert 'set mass_model = "lumped" on the step to save that first run' in ds.attrs["note"]
     found = re.search(r"element (c\.\d+): λ² ([0-9.e+]+) at the start, tension ([0-9.e+]+) N "
                       r"at t = ([0-9.e+]+) s, past ([0-9.e+]+) N, where λ² is 1", choice)
     assert found, choice
