@@ -22,7 +22,7 @@ SETTINGS = ("rtol", "atol", "elements", "gauss_points", "mass_model", "linear_so
             "max_order")
 MODAL_SETTINGS = ("elements", "gauss_points", "mass_model")
 STATIC_SETTINGS = ("elements", "gauss_points")  # catdae.study.quantity
-STORE_FORMAT = 2  # bump when the stored runs change meaning
+STORE_FORMAT = 3  # bump when the stored runs change meaning
 
 COORD_META = {  # setting -> (units, long_name); labels (strings) get no units
     "rtol": ("1", "relative tolerance of IDA"),

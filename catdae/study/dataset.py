@@ -36,6 +36,7 @@ def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
     data = {v: np.full(shape, np.nan) for v in ("wall_time", *COUNTS, "peak_memory", "error",
                                                 "peak_tension_error")}
     status = np.full(shape, "", dtype=object)
+    said = {v: np.full(shape, "", dtype=object) for v in ("mass_model_used", "note")}
     ref_ok = ref.attrs.get("status", "completed") == "completed"
     single = target[1] if isinstance(target, tuple) and target[0] == "mode" else None
     if st.kind == "transient":
@@ -53,6 +54,8 @@ def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
         idx = tuple(grid[n].index(combo[n]) for n in names)
         rec = records[key]
         status[idx] = str(rec.attrs["status"])
+        for v, texts in said.items():
+            texts[idx] = str(rec.attrs.get(v, ""))
         for v in ("wall_time", *COUNTS, "peak_memory"):
             data[v][idx] = float(rec.attrs.get(v, math.nan))
         if status[idx] != "completed" or not ref_ok:
@@ -107,6 +110,11 @@ def assemble(grid, combos, keys, records, ref, st: Step, target) -> xr.Dataset:
                  for v, (u, ln) in meta.items()}
     variables["status"] = xr.Variable(dims, status, {"long_name": "run status "
                                                      "('completed' or why it stopped)"})
+    if st.kind != "static":
+        variables["mass_model_used"] = xr.Variable(dims, said["mass_model_used"], {
+            "long_name": "mass model the run's step used (what mass_model \"auto\" chose)"})
+    variables["note"] = xr.Variable(dims, said["note"], {
+        "long_name": "the run's step note (what catdae run would print; '' for none)"})
     if st.kind == "transient":
         variables["peak_tension_error"] = xr.Variable(dims, data["peak_tension_error"], {
             "units": "1", "long_name": "relative error of the step's largest tension (its "

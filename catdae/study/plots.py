@@ -35,6 +35,16 @@ def _families(ds: xr.Dataset, line_dim: str) -> Iterator[tuple[str, dict]]:
         yield label, sel
 
 
+def mixed_mass_models(ds: xr.Dataset, sel: dict | None = None) -> list[str]:
+    """The mass models the runs (of ``sel``, by index) used, when more than one and the study
+    does not sweep the mass model itself (``auto`` chose them); else []."""
+    if "mass_model_used" not in ds or ds.sizes.get("mass_model", 1) > 1:
+        return []
+    used = ds.mass_model_used if sel is None else ds.mass_model_used.isel(sel)
+    names = sorted({str(v) for v in np.ravel(used.values)} - {""})
+    return names if len(names) > 1 else []
+
+
 def _line_dim(ds: xr.Dataset) -> str:
     for d in ("rtol", "atol", "elements", "max_order", "gauss_points"):
         if d in ds.dims and ds.sizes[d] > 1:
@@ -94,9 +104,12 @@ def plot_convergence(ds: xr.Dataset, path: str | os.PathLike | None = None):
         err = ds.error.isel(sel)
         p = convergence_order(err)
         ok = np.isfinite(err.values) & (err.values > 0)
+        mixed = mixed_mass_models(ds, sel)  # no one order across two methods
         if ok.any():
             ax.loglog(err.elements.values[ok], err.values[ok], "o-",
-                      label=f"{label + ': ' if label else ''}order {p:.2f}")
+                      label=f"{label + ': ' if label else ''}"
+                            + (f"mass {' / '.join(mixed)}: no order" if mixed
+                               else f"order {p:.2f}"))
     ax.set_xlabel("elements per cable")
     ax.set_ylabel(f"error ({ds.error.attrs['units']})")
     ax.set_title(f"{ds.attrs.get('case_name', '')}: {ds.attrs.get('response', '')}", fontsize=9)

@@ -11,7 +11,7 @@ import numpy as np
 from catdae._xr import xr
 from catdae.output.results import write_atomic
 from catdae.study.core import SETTINGS
-from catdae.study.plots import plot_convergence, plot_work_precision
+from catdae.study.plots import mixed_mass_models, plot_convergence, plot_work_precision
 
 
 def write_study(ds: xr.Dataset, path: str | os.PathLike, plots: bool = True) -> list[Path]:
@@ -30,11 +30,15 @@ def write_study(ds: xr.Dataset, path: str | os.PathLike, plots: bool = True) -> 
 
 
 def summary(ds: xr.Dataset) -> str:
-    """One line per run: its swept settings, cost and error."""
+    """One line per run: its swept settings, cost and error (and the mass model where
+    ``auto`` chose different ones, and the step's note)."""
     swept = [d for d in SETTINGS if d in ds.dims and ds.sizes[d] > 1]
     lines = [f"study of step '{ds.attrs['step']}' of {ds.attrs['case_name']}: response "
              f"{ds.attrs['response']}; reference {ds.attrs['reference']}"]
     per_mode = [v for v in ("frequency_error", "matched_mode", "shape_correlation") if v in ds]
+    used = mixed_mass_models(ds)
+    notes = {str(v) for v in np.ravel(ds.note.values)} if "note" in ds else set()
+    common = notes.pop() if len(notes) == 1 and ds.note.size > 1 else ""  # said once
     flat = ds.drop_vars(per_mode).stack(run=list(d for d in SETTINGS if d in ds.dims))
     units = ds.error.attrs["units"]
     matched = (ds.matched_mode.stack(run=list(flat.indexes["run"].names))
@@ -56,8 +60,17 @@ def summary(ds: xr.Dataset) -> str:
                 err += (f" (no mode of the shape of the reference's mode"
                         f"{'s' if len(missing) > 1 else ''} {', '.join(missing)}: this run "
                         "does not resolve it)")
-        lines.append(f"  {what}: {r.status.item()}, {float(r.wall_time):.3g} s{counts}, "
+        mass = f", mass {r.mass_model_used.item()}" if used else ""
+        lines.append(f"  {what}: {r.status.item()}{mass}, {float(r.wall_time):.3g} s{counts}, "
                      f"{err}{peak}")
+        if "note" in r and str(r.note.item()) and not common:
+            lines.append(f"    note: {r.note.item()}")
+    if common:
+        lines.append(f"  note of every run: {common}")
+    if used:
+        lines.append(f"  (mass_model \"auto\" chose {' and '.join(used)} in different runs: "
+                     "their errors mix two methods and are not one method's convergence; "
+                     "give --mass-model to hold it)")
     if "reference_elements" in ds.attrs and ds.sizes.get("elements", 1) > 1:  # automatic
         lines.append("  (the reference is computed, not exact: the errors of the finest runs "
                      "include its own, about theirs / (2^p - 1) for a mesh twice as fine at "

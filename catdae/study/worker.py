@@ -24,7 +24,8 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
     The Dataset holds ``displacement``(time, point, axis) at every node, labelled by
     :func:`point_labels` (transient), or ``frequency``(mode) and ``shape`` (modal,
     :func:`catdae.study.modes.mode_samples`), and attrs ``status``,
-    ``wall_time``, ``peak_memory`` and the transient's evaluation counts (NaN when absent).
+    ``wall_time``, ``peak_memory``, the transient's evaluation counts (NaN when absent), the
+    mass model the step used (``mass_model_used``, "" for a static step) and its ``note``.
     Analysis failures become a status, never an exception.
     """
     step = next(s for s in case_run.steps if s.name == step_name)
@@ -57,6 +58,10 @@ def execute(case_run: Case, step_name: str, memory: str = "rss") -> xr.Dataset:
     for k in COUNTS:
         v = group.attrs.get(k) if group is not None else None
         attrs[k] = float(v) if v is not None else math.nan
+    # what the step chose and said (mass_model "auto" per run; the note: rtol below atol, ...)
+    got = group.attrs if group is not None else {}
+    attrs["mass_model_used"] = str(got.get("mass_model", ""))
+    attrs["note"] = str(got.get("note", ""))
     if group is None or status != "completed":
         return xr.Dataset(attrs=attrs)
     if step.kind == "modal":

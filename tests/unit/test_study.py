@@ -19,6 +19,7 @@ from catdae.study import StudyError, convergence_order, run_study
 
 from repo_paths import CASES  # noqa: E402
 from scene_toml import cable_scene, falling_mass, modal_step, static_step
+from scene_toml import step as step_block
 
 GENTLE = CASES / "example2_support_motion_gentle.toml"
 EXAMPLE1 = CASES / "example1_free_vibration.toml"
@@ -415,3 +416,35 @@ def test_a_mode_the_mesh_cannot_hold_is_not_paired_with_a_neighbour(mass_model):
                     reference={"elements": 20}, response="frequency:10",
                     scheduler="synchronous")
     assert math.isinf(float(one.error.squeeze()))
+
+
+def test_a_study_says_which_mass_auto_chose_and_what_each_run_noted(tmp_path):
+    """A sagging span driven at one end (tester t74): ``auto`` keeps the blended mass at 32
+    elements and reruns lumped at 4 (its sagging elements are pulled taut), so the errors mix
+    two methods; the study said neither, and fitted one "order" through them. Each run's mass
+    model and note are variables; the table names the mass where they differ and the
+    convergence figure fits no order across them. A tolerance the atol makes idle is noted,
+    as `catdae run` notes it."""
+    from catdae.study import summary
+    from catdae.study.plots import plot_convergence
+
+    text = cable_scene(B=(100.0, 0.0, 0.0), L0=101.0, EA=1.0e7, mass=5.0, elements=8,
+                       extra='[[support_motions]]\nnode = "B"\nz = { kind = "cosine", '
+                             'amplitude = -0.5, frequency = 0.5, offset = 0.5 }\n',
+                       steps=step_block("static", "hang")
+                       + step_block("transient", "drive", duration=6.0, output_interval=0.02))
+    ds = run_study(text, elements=[4, 32], rtol=[1e-4], scheduler="synchronous",
+                   reference={"elements": 48})
+    used = ds.mass_model_used.squeeze().values.tolist()
+    assert used == ["lumped", "blended"], used
+    assert "pulled sagging elements taut" in str(ds.note.sel(elements=4).item())
+    printed = summary(ds)
+    assert "elements=4: completed, mass lumped" in printed
+    assert 'auto" chose blended and lumped in different runs' in printed
+    fig = plot_convergence(ds)
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == [
+        "mass blended / lumped: no order"]
+    idle = run_study(text, elements=[4], rtol=[1e-9], atol=[1e-6], duration=0.5,
+                     scheduler="synchronous", reference={"rtol": 1e-9, "atol": 1e-9})
+    assert "below atol" in str(idle.note.item()), idle.note.item()
+    assert "note: " in summary(idle)
