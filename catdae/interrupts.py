@@ -12,6 +12,7 @@ is left alone and :func:`deferred` does nothing.
 
 from __future__ import annotations
 
+import os
 import signal
 import threading
 from collections.abc import Iterator
@@ -35,8 +36,27 @@ def _handler(signum, frame):
     if _State.deferring:
         _State.pending = signum
         return
+    if _in_llvm(frame):  # an exception raised there is dropped (a ctypes callback): again soon
+        threading.Timer(RESEND, os.kill, (os.getpid(), signum)).start()
+        return
     _State.stopping = True
     raise Interrupted(signum)
+
+
+RESEND = 0.02  # s: a signal that came inside llvmlite is sent again after this
+
+
+def _in_llvm(frame) -> bool:
+    """Whether the main thread is inside llvmlite (numba loading or compiling a kernel): its
+    execution engine calls back into Python through ctypes, which drops an exception raised
+    in the callback ("Exception ignored on calling ctypes callback function"), so a Ctrl-C
+    there was lost, and every later signal ignored as if the run were stopping (tester t75:
+    exit 0, status completed, after SIGINT, SIGINT and SIGTERM)."""
+    while frame is not None:
+        if "llvmlite" in frame.f_code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
 
 
 @contextmanager

@@ -315,3 +315,27 @@ def test_snapshots_come_between_outputs_and_leave_the_run_as_it_was(tmp_path, mo
     for name in ("position", "velocity", "tension", "tension_max", "time_tension_max"):
         np.testing.assert_array_equal(snapped[name].values, plain[name].values, err_msg=name)
     assert not (tmp_path / "s.partial.nc").exists()  # removed at the end
+
+
+def test_a_signal_inside_llvmlite_is_sent_again_not_lost():
+    """llvmlite's execution engine calls back into Python through ctypes, which drops an
+    exception raised there: a Ctrl-C while numba loaded a kernel was lost, and every later
+    signal ignored as if the run were stopping (tester t75: exit 0, "completed", after SIGINT,
+    SIGINT and SIGTERM). Inside llvmlite the handler sends the signal again shortly; it is
+    raised once the main thread is back in catdae's code."""
+    import time
+
+    from catdae import interrupts
+
+    code = compile("import sys\ndef here():\n    return sys._getframe()\n",
+                   "/site-packages/llvmlite/binding/executionengine.py", "exec")
+    scope: dict = {}
+    exec(code, scope)
+    inside = scope["here"]()
+    with interrupts.signals_as_interrupts():
+        assert interrupts._handler(signal.SIGINT, inside) is None  # not raised there
+        assert not interrupts._State.stopping
+        with pytest.raises(catdae.Interrupted):
+            for _ in range(500):  # the signal comes back after RESEND s
+                time.sleep(0.01)
+        assert interrupts._State.stopping
