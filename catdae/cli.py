@@ -177,7 +177,11 @@ def _run(args) -> int:
     def finished(name, ds):  # each step's summary as it ends: an interrupted run has them
         if not titled:
             titled.append(say(case.title or "catdae run"))
-        text = step_summary(name, ds)
+        try:
+            text = step_summary(name, ds)
+        except (MemoryError, Exception) as exc:  # noqa: BLE001 - a summary never costs the run
+            text = (f"[{name}] (no summary printed: {type(exc).__name__} while summarising; "
+                    "the step's results are kept)")
         if text:
             say(text)
 

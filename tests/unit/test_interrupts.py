@@ -339,3 +339,22 @@ def test_a_signal_inside_llvmlite_is_sent_again_not_lost():
             for _ in range(500):  # the signal comes back after RESEND s
                 time.sleep(0.01)
         assert interrupts._State.stopping
+
+
+def test_a_summary_out_of_memory_keeps_the_finished_run(tmp_path, monkeypatch, capsys):
+    """The printed summary of a finished transient ran out of memory (a 40 MB temporary over
+    50 001 outputs under a memory limit): the error escaped the run, and no file was written
+    (tester t75). A summary never costs the results: the file holds every step, completed."""
+    def no_memory(name, ds):
+        raise MemoryError
+
+    monkeypatch.setattr(catdae.cli, "step_summary", no_memory)
+    out = tmp_path / "r.nc"
+    assert main(["run", str(THREE), "-o", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    assert "no summary printed: MemoryError while summarising" in printed
+    tree = catdae.read_results(out)
+    case = catdae.load_case(THREE)
+    assert list(tree.children) == [s.name for s in case.steps]
+    assert all(tree[s.name].ds.attrs["status"] == "completed" for s in case.steps
+               if "status" in tree[s.name].ds.attrs)
