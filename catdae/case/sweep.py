@@ -87,6 +87,12 @@ class SweepPass:
                                  f"{'>=' if inclusive else '>'} {bound:g} for {field}, found "
                                  f"{found_text(v)}")
                     ok = False
+        steps = [b - a for a, b in zip(values, values[1:], strict=False)]
+        if not (all(d > 0 for d in steps) or all(d < 0 for d in steps)):
+            self.problem(where + ("values",), "expected values in strictly increasing or "
+                         f"decreasing order (they label the results' sweep coordinate, and "
+                         f"sel(sweep=v) picks one), found {found_text(values)}")
+            ok = False
         return Sweep(field, tuple(float(v) for v in values)) if ok else False
 
 

@@ -219,6 +219,7 @@ def write_atomic(data: xr.DataTree | xr.Dataset, path: str | os.PathLike) -> Pat
     path = Path(path)
     clean_stale(path.parent, path.name + ".")
     tmp = incomplete_name(path)
+    no_fill_on_coordinates(data)
     try:
         data.to_netcdf(tmp, engine="netcdf4")
         os.replace(tmp, path)
@@ -253,8 +254,15 @@ def read_tree(path: str | os.PathLike) -> xr.DataTree:
     in seconds on the case's clock (not decoded to dates: see TIME_UNITS)."""
     with xr.open_datatree(path, engine="netcdf4", decode_times=False) as tree:
         tree = tree.load()
-    for node in tree.subtree:  # written again, coordinate variables get no fill value (CF)
+    return no_fill_on_coordinates(tree)  # written again, as CF asks
+
+
+def no_fill_on_coordinates(data: xr.DataTree | xr.Dataset):
+    """``data`` with no ``_FillValue`` on its float coordinate variables (CF §2.5.1; xarray
+    gives them NaN: a sweep's values failed compliance-checker), set in their encoding."""
+    nodes = data.subtree if isinstance(data, xr.DataTree) else [data]
+    for node in nodes:
         for name in node.dims:
             if name in node.variables and node.variables[name].dtype.kind == "f":
                 node.variables[name].encoding["_FillValue"] = None
-    return tree
+    return data

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import catdae
+import catdae.output.results
 from catdae.case import case_from_dict
 
 from scene_toml import damper, load, point_mass, scene, spring, step
@@ -20,7 +21,7 @@ SPRING = scene(head={"title": "a weight on a spring", "gravity": 0.0}, materials
                       + point_mass("m", 4.0, node="N") + load("P", [0.0, 0.0, -100.0], node="N")))
 
 
-def test_load_factor_and_coefficient_sweeps_against_closed_forms():
+def test_load_factor_and_coefficient_sweeps_against_closed_forms(tmp_path):
     """A mass m on a spring k (rest length 1 m, along z) under a load f P: the spring stretches
     by f P / k exactly; the damped mode has ζ = c / (2 √(k m)) whatever the stretch (the spring
     and damper act along the same line), for each swept coefficient."""
@@ -31,6 +32,12 @@ def test_load_factor_and_coefficient_sweeps_against_closed_forms():
     tree = catdae.run(case_from_dict(tomllib.loads(text)))
     st = tree["loads"].ds
     assert st.sweep.attrs["units"] == "1" and st.attrs["sweep_field"] == "load_factor"
+    path = tmp_path / "sw.nc"  # a coordinate variable has no _FillValue (CF 2.5.1; tester t75)
+    catdae.output.results.write_tree(tree, path)
+    import netCDF4
+
+    with netCDF4.Dataset(path) as f:
+        assert "_FillValue" not in f["loads"]["sweep"].ncattrs()
     f = st.sweep.values
     assert np.allclose(f, [0.5, 1.0, 2.0])
     z = st.position.sel(node="N", axis="z").values
@@ -55,6 +62,9 @@ def test_load_factor_and_coefficient_sweeps_against_closed_forms():
      "expected a value >= 0 for dampers.d.coefficient, found the number -2.0"),
     ({"field": "load_factor", "values": []}, "steps[0].sweep.values",
      "expected a non-empty list of finite numbers"),
+    # a coordinate: sel(sweep=0.5) gave two entries (tester t75; CF wants it monotonic)
+    ({"field": "load_factor", "values": [0.5, 2.0, 0.5]}, "steps[0].sweep.values",
+     "expected values in strictly increasing or decreasing order"),
 ])
 def test_bad_sweeps_are_located(sweep, field, words, tmp_path, capsys):
     from catdae.cli import main
