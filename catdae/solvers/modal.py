@@ -122,8 +122,10 @@ def _cable_plane(P: np.ndarray):
     """(along the chord, normal to it in the cable's plane, normal to the plane) of the nodes
     P (n_along, 3) in order: the plane through the chord that holds their offsets from it
     best (the sag's direction), or the vertical plane through the chord of a straight cable;
-    None for a straight vertical one."""
+    None for a straight vertical one, and for ends brought together (no chord)."""
     chord = P[-1] - P[0]
+    if np.linalg.norm(chord) <= 1e-9 * np.ptp(P, axis=0).max(initial=0.0):
+        return None  # a loop: its ends met (a support motion brought them together)
     t_chord = chord / np.linalg.norm(chord)
     rel = P - P[0]
     offsets = rel - np.outer(rel @ t_chord, t_chord)  # normal to the chord

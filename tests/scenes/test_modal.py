@@ -708,3 +708,19 @@ def test_labels_follow_the_plane_of_a_cable_swung_by_wind():
         assert label == ("out-of-plane" if share > 0.5 else "in-plane"), (k, share, label)
         assert min(share, 1 - share) < 0.01  # each mode is clearly one or the other
     assert str(modes.plane.values[0]) == "out-of-plane"  # the swing
+
+
+def test_a_cable_whose_ends_met_has_no_plane_and_its_modes_are_unclassified():
+    """A support motion drove B onto A (tester t75): the modal step after divided by the zero
+    chord and failed as an "internal error". A loop has no chord, so no plane of its own: its
+    modes are unclassified, as a straight vertical cable's are; a sagging span keeps its
+    vertical plane."""
+    from catdae.solvers.modal import _cable_plane
+
+    s = np.linspace(0.0, 2.0 * np.pi, 9)
+    loop = np.stack([np.sin(s), np.zeros_like(s), np.cos(s) - 1.0], axis=1)
+    loop[-1] = loop[0]
+    assert _cable_plane(loop) is None
+    span = np.stack([10.0 * s, np.zeros_like(s), 0.1 * s * (s - s[-1])], axis=1)
+    along, in_plane, normal = _cable_plane(span)
+    np.testing.assert_allclose(np.abs(normal), [0.0, 1.0, 0.0], atol=1e-12)
