@@ -187,7 +187,8 @@ def _mass_note(model: Model, prob) -> str:
     jumps = [j for j in prob.velocity_jumps if j[2] > 1.0 and j[1] >= floor]
     changed = [*prob.step.add, *prob.step.remove]
     lam2 = getattr(prob, "lambda2_start", 0.0)
-    if not jumps and changed and lam2 > 1.0:
+    acts = getattr(prob, "unbalance_start", 1.0) > 1e-6  # of the largest tension: a change
+    if not jumps and changed and acts and lam2 > 1.0:
         return (f"{', '.join(repr(c) for c in changed)} added or removed at the start of the "
                 "step act(s) suddenly: the axial wave that sends (a snap where elements are "
                 "slack) is not fully carried by the consistent catenary mass of elements that "

@@ -9,6 +9,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from catdae.errors import SolverError
+from catdae.model.snap import unbalance_forces
 
 
 class ConsistentStart:
@@ -46,8 +47,15 @@ class ConsistentStart:
         mdata = self.mass_data(conf)
         mff = self.ff(mdata).tocsc()
         if where == "transient start":  # for the note on loads that come or go (snaps)
-            self.lambda2_start = float(m.element_lambda2(conf[0], self.X.reshape(-1, 3)).max(
-                initial=0.0))
+            X = self.X.reshape(-1, 3)
+            self.lambda2_start = float(m.element_lambda2(conf[0], X).max(initial=0.0))
+            # the force out of balance at the start, against the largest tension: a load
+            # removed whose time function is 0 there changes nothing (tester t75)
+            full_v = np.zeros(X.shape)
+            full_v.reshape(-1)[self.fidx] = v0
+            self.unbalance_start = float(np.linalg.norm(unbalance_forces(
+                m, conf[0], X, t0, full_v), axis=1).max(initial=0.0)) / max(
+                float(m.tensions(conf[0]).max(initial=0.0)), 1e-300)
         vs_after = self._supports(t0)[1]
         dvs = vs_after - vs_before
         # a jump, not the round-off of two evaluations of a smooth motion
