@@ -71,6 +71,8 @@ def summary(ds: xr.Dataset) -> str:
         lines.append(f"  (mass_model \"auto\" chose {' and '.join(used)} in different runs: "
                      "their errors mix two methods and are not one method's convergence; "
                      "give --mass-model to hold it)")
+    if "reference_note" in ds.attrs:
+        lines.append(f"  note: {ds.attrs['reference_note']}")
     if "reference_elements" in ds.attrs and ds.sizes.get("elements", 1) > 1:  # automatic
         lines.append("  (the reference is computed, not exact: the errors of the finest runs "
                      "include its own, about theirs / (2^p - 1) for a mesh twice as fine at "

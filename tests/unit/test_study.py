@@ -266,6 +266,13 @@ def test_a_given_reference_gives_the_automatic_errors():
     assert given.attrs["reference"] == "given by the user"
     assert given.attrs["response"] == auto.attrs["response"]
     np.testing.assert_allclose(given.error.values, auto.error.values, rtol=1e-12)
+    assert "reference_note" not in given.attrs  # the same scene at other settings
+    # another scene's results (a heavier cable) are said to be so (tester t74: silent)
+    heavier = GENTLE.read_text().replace("mass = 5.0", "mass = 6.0")
+    other = study.configure(load_case(heavier), "excitation", ref_settings, duration=0.1)
+    wrong = run_study(GENTLE, reference=catdae.run(other), **kw)
+    assert "differs from the study's in materials" in wrong.attrs["reference_note"]
+    assert "note: the reference's case differs" in study.summary(wrong)
 
 
 def test_a_given_reference_must_cover_the_step_and_is_named(tmp_path, capsys):
