@@ -35,6 +35,20 @@ def _families(ds: xr.Dataset, line_dim: str) -> Iterator[tuple[str, dict]]:
         yield label, sel
 
 
+ROUNDING = 1e-10  # relative errors at or below this: two exact answers, to the solves' tolerance
+
+
+def at_rounding(ds: xr.Dataset, sel: dict | None = None) -> bool:
+    """Whether every finite relative error (of ``sel``) is rounding (a mesh-exact static
+    study: 1e-15 to 4e-12, the static solves' tolerance), where a fitted order would be noise;
+    False for errors in metres."""
+    if ds.error.attrs.get("units") != "1":
+        return False
+    e = np.abs(ds.error.values if sel is None else ds.error.isel(sel).values)
+    e = e[np.isfinite(e)]
+    return bool(e.size) and bool((e <= ROUNDING).all())
+
+
 def mixed_mass_models(ds: xr.Dataset, sel: dict | None = None) -> list[str]:
     """The mass models the runs (of ``sel``, by index) used, when more than one and the study
     does not sweep the mass model itself (``auto`` chose them); else []."""
@@ -109,6 +123,7 @@ def plot_convergence(ds: xr.Dataset, path: str | os.PathLike | None = None):
             ax.loglog(err.elements.values[ok], err.values[ok], "o-",
                       label=f"{label + ': ' if label else ''}"
                             + (f"mass {' / '.join(mixed)}: no order" if mixed
+                               else "at solver tolerance: no order" if at_rounding(ds, sel)
                                else f"order {p:.2f}"))
     ax.set_xlabel("elements per cable")
     ax.set_ylabel(f"error ({ds.error.attrs['units']})")

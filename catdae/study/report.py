@@ -11,7 +11,12 @@ import numpy as np
 from catdae._xr import xr
 from catdae.output.results import write_atomic
 from catdae.study.core import SETTINGS
-from catdae.study.plots import mixed_mass_models, plot_convergence, plot_work_precision
+from catdae.study.plots import (
+    at_rounding,
+    mixed_mass_models,
+    plot_convergence,
+    plot_work_precision,
+)
 
 
 def write_study(ds: xr.Dataset, path: str | os.PathLike, plots: bool = True) -> list[Path]:
@@ -73,7 +78,10 @@ def summary(ds: xr.Dataset) -> str:
                      "give --mass-model to hold it)")
     if "reference_note" in ds.attrs:
         lines.append(f"  note: {ds.attrs['reference_note']}")
-    if "reference_elements" in ds.attrs and ds.sizes.get("elements", 1) > 1:  # automatic
+    if at_rounding(ds):
+        lines.append("  (every error is at the level of the solves' tolerance, 1e-10 or less: "
+                     "the runs agree with the reference, and no order can be read)")
+    elif "reference_elements" in ds.attrs and ds.sizes.get("elements", 1) > 1:  # automatic
         lines.append("  (the reference is computed, not exact: the errors of the finest runs "
                      "include its own, about theirs / (2^p - 1) for a mesh twice as fine at "
                      "order p, as large as theirs at first order; check them against a finer "

@@ -63,3 +63,24 @@ def test_bad_responses(step, response, words, tmp_path, capsys):
     assert main([str(case), "--step", step, "--response", response, "--scheduler",
                  "synchronous", "--store", str(tmp_path / "s")]) == 2
     assert words in capsys.readouterr().err
+
+
+def test_a_mesh_exact_static_study_says_its_errors_are_rounding():
+    """Self-weight alone: the catenary element is exact at any mesh (Irvine), so a mesh study's
+    errors are 1e-15 to 4e-12 (the solves' tolerance); the table said the reference is
+    "computed, not exact" and the figure fitted "order 0.08" to rounding (tester t74). Both
+    now say so."""
+    from catdae.study import summary
+    from catdae.study.plots import plot_convergence
+
+    text = cable_scene(B=(100.0, 0.0, 20.0), L0=104.0, EA=2.0e7, mass=8.0, elements=4,
+                       steps=static_step("hang"))
+    ds = run_study(text, elements=[1, 2, 4, 8], response="end_tension:c:j",
+                   scheduler="synchronous")
+    assert float(np.abs(ds.error).max()) <= 1e-10  # the static solves' tolerance
+    printed = summary(ds)
+    assert "every error is at the level of the solves' tolerance" in printed
+    assert "computed, not exact" not in printed
+    fig = plot_convergence(ds)
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == [
+        "at solver tolerance: no order"]
