@@ -44,10 +44,11 @@ class StepsPass:
                 continue
             if v.node not in self.node_names:
                 mesh = cable_of(v.node) in self.cable_names  # a node of a cable's mesh
+                held = ", ".join(map(repr, sorted(self.support_names & self.node_names)))
                 self.problem(where + ("node",), (
                     f"{v.node!r} is a mesh node of cable {cable_of(v.node)!r}, and mesh nodes "
                     "cannot be supported: only a [nodes] entry that is in [supports] can be "
-                    f"moved (supported nodes: {', '.join(map(repr, sorted(self.support_names)))})"
+                    f"moved (supported nodes: {held})"
                 ) if mesh else unknown_word(v.node, "node", sorted(self.node_names)))
                 ok = False
             elif v.node not in self.support_names:

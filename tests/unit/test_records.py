@@ -196,6 +196,14 @@ def test_record_columns_and_quantity_are_checked(tmp_path, capsys):
     err = capsys.readouterr().err
     assert (f"{case}: support_motions[0].node: 'c.1' is a mesh node of cable 'c', and mesh "
             "nodes cannot be supported") in err, err
+    case.write_text(cable_scene(  # listed in [supports] too: refused there, not listed as held
+        B=(10.0, 0.0, 0.0), L0=10.2, EA=1e7, mass=1.0, elements=2,
+        supports=("A", "B", '"c.1" = "pinned"'),
+        extra=support_motion("c.1", x={"kind": "sine", "amplitude": 0.1, "frequency": 1.0}),
+        steps=transient_step("s", 1.0, 0.1, rtol=1e-6, atol=1e-8)))
+    assert main(["check", str(case)]) == 2
+    err = capsys.readouterr().err
+    assert "(supported nodes: 'A', 'B')" in err and "unknown node 'c.1'" in err, err
 
 
 def test_velocity_and_displacement_columns_through_the_case_format(tmp_path):
