@@ -66,7 +66,8 @@ def output_times(ds: xr.Dataset, times) -> np.ndarray:
     if wanted.ndim != 1 or wanted.size == 0 or not np.isfinite(wanted).all():
         why = "expected one or more finite times (s)"
     elif ((wanted < t[0] - half) | (wanted > t[-1] + half)).any():
-        why = f"the step's outputs run from {t[0]:g} to {t[-1]:g} s (--step picks the step)"
+        why = (f"the step's outputs run from {t[0]:g} to {t[-1]:g} s (another step: catdae "
+               "plot --step, or its group in Python)")
     else:
         return np.array([t[np.abs(t - x).argmin()] for x in wanted])
     raise PlotError(f"times: {why}, found {np.array2string(wanted, threshold=6)}")
