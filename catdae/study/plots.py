@@ -68,22 +68,25 @@ def _line_dim(ds: xr.Dataset) -> str:
 
 def plot_work_precision(ds: xr.Dataset, path: str | os.PathLike | None = None):
     """Error against wall time and against residual evaluations (log-log), one line per family
-    of settings, along the first swept of rtol, atol, elements. Returns the matplotlib Figure,
-    drawn on an Agg canvas without pyplot (so the caller's backend is left alone); with
-    ``path``, also writes it as PNG."""
+    of settings, along the first swept of rtol, atol, elements; for a transient a second row,
+    the relative error of the largest tension (``peak_tension_error``, absolute value).
+    Returns the matplotlib Figure, drawn on an Agg canvas without pyplot (so the caller's
+    backend is left alone); with ``path``, also writes it as PNG."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     line = _line_dim(ds)
     costs = [c for c in ("wall_time", "n_residual_evaluations")
              if np.isfinite(ds[c].values).any()]
-    fig = Figure(figsize=(5.5 * max(len(costs), 1), 4.5), layout="constrained")
+    errors = ["error"] + (["peak_tension_error"] if "peak_tension_error" in ds
+                          and np.isfinite(ds.peak_tension_error.values).any() else [])
+    fig = Figure(figsize=(5.5 * max(len(costs), 1), 4.5 * len(errors)), layout="constrained")
     FigureCanvasAgg(fig)
-    for k, cost in enumerate(costs):
-        ax = fig.add_subplot(1, len(costs), k + 1)
+    for k, (err, cost) in enumerate(itertools.product(errors, costs)):
+        ax = fig.add_subplot(len(errors), len(costs), k + 1)
         for label, sel in _families(ds, line):
             sub = ds.isel(sel)
-            x, y = sub[cost].values, sub["error"].values
+            x, y = sub[cost].values, np.abs(sub[err].values)
             ok = np.isfinite(x) & np.isfinite(y) & (x > 0) & (y > 0)
             if ok.any():
                 ax.loglog(x[ok], y[ok], "o-", label=label or None)
@@ -91,7 +94,8 @@ def plot_work_precision(ds: xr.Dataset, path: str | os.PathLike | None = None):
                     ax.annotate(f"{v:g}" if isinstance(v, float) else str(v), (xi, yi),
                                 fontsize=7, textcoords="offset points", xytext=(3, 3))
         ax.set_xlabel(f"{ds[cost].attrs['long_name']} ({ds[cost].attrs['units']})")
-        ax.set_ylabel(f"error ({ds.error.attrs['units']})")
+        ax.set_ylabel(f"error ({ds.error.attrs['units']})" if err == "error"
+                      else "|relative error of the largest tension|")
         ax.set_title(f"{ds.attrs.get('case_name', '')}: points labelled by {line}", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         if ax.get_legend_handles_labels()[0]:

@@ -363,6 +363,13 @@ def test_peak_tension_error_shrinks_as_the_tolerance_tightens():
     given = run_study(text, reference=catdae.run(ref_case), **kw)
     np.testing.assert_allclose(given.peak_tension_error.values, ds.peak_tension_error.values,
                                rtol=1e-9)
+    # the work-precision figure has a row of it (tester t74: not drawn), the points its values
+    from catdae.study.plots import plot_work_precision
+
+    fig = plot_work_precision(ds)
+    rows = [ax for ax in fig.axes if "largest tension" in ax.get_ylabel()]
+    assert len(rows) == 2  # against wall time and residual evaluations
+    np.testing.assert_allclose(rows[0].get_lines()[0].get_ydata(), err, rtol=1e-12)
 
 
 def test_the_command_line_takes_max_order_auto():
