@@ -18,7 +18,7 @@ from repo_paths import ROOT
 PACKAGE = ROOT / "catdae"
 RANK = {"errors": 0, "_version": 0, "_xr": 0, "_numpy_extras": 0, "interrupts": 0, "progress": 0,
         "case": 1, "element": 1, "model": 2, "solvers": 3, "output": 4, "analysis": 5,
-        "study": 6, "cli": 7, "__main__": 8, "__init__": 8}
+        "study": 6, "cli": 7, "__main__": 8, "_entry": 8, "__init__": 8}
 MODULES = sorted(p for p in PACKAGE.rglob("*.py"))
 
 
