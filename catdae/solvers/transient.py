@@ -151,7 +151,7 @@ class _Run:
         self.resolve, self.resolve_choice = resolve_mode(
             step.resolve, self.model.mass_model.carries_axial_waves, bool(jumps))
         atol, self.omega_error = error_weights(self.resolve, step.atol, self.omega,
-                                               self.dt_out, prob.n)
+                                               self.dt_out, prob.n, step.rtol)
         self.auto = step.max_order == "auto"
         self.order_choice = (OrderChoice(highest_frequency(prob, t0, y0), self.omega,
                                          self.t_end) if self.auto else None)
