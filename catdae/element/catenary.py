@@ -362,6 +362,24 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
         # Δz = L0 - 2 s* + L0 (V + w L0/2)/EA, linear in V; no lateral stiffness.
         fzz = 2.0 / w + l0 / ea
         v = (c[2] - l0 - 0.5 * w * l0 * l0 / ea) / fzz
+        # hanging straight with its tension vanishing at its lower end (the free end of a
+        # hanging chain, whose static solve leaves it folded by 1e-11 to 1e-9 m: the fold's
+        # axial stiffness is only w/2). Newton met T = 0 at that end. Where the chord is
+        # within 1e-6 of L0 of the hanging length L0 + w L0²/(2 EA), the element is taken as
+        # hanging straight with the tension EA (|Δz| - that length) / L0 at its lower end, at
+        # least 1e-9 of its weight (the lateral stiffness falls only as 1 / log of it), not
+        # as folded, whose lateral stiffness is zero (a spurious zero mode at a chain's free
+        # end; tester t78)
+        t_end = ea * (-c[2] - l0 - 0.5 * w * l0 * l0 / ea) / l0
+        if c[2] < 0.0 and abs(t_end) <= 1e-6 * ea:
+            h[0] = 0.0
+            h[1] = 0.0
+            h[2] = -w * l0 - max(t_end, 1e-9 * w * l0)
+            if partial_solution(h[0], h[1], h[2], w, ea, l0, ls, lf, k0, k1, d, f, True):
+                for m in range(6):
+                    fout[m] = f[m]
+                if inv_sym3(f, kout):
+                    return it, CONVERGED
         if 0.0 < -v / w < l0:
             h[0] = 0.0
             h[1] = 0.0
