@@ -370,11 +370,14 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
         # least 1e-9 of its weight (the lateral stiffness falls only as 1 / log of it), not
         # as folded, whose lateral stiffness is zero (a spurious zero mode at a chain's free
         # end; tester t78)
-        t_end = ea * (-c[2] - l0 - 0.5 * w * l0 * l0 / ea) / l0
-        if c[2] < 0.0 and abs(t_end) <= 1e-6 * ea:
+        # (its lower end is j where the chord points down, i where it points up: h is the
+        # force at i along the chord, -(w L0 + T_j) or +T_i)
+        t_end = ea * (abs(c[2]) - l0 - 0.5 * w * l0 * l0 / ea) / l0
+        if abs(t_end) <= 1e-6 * ea:
             h[0] = 0.0
             h[1] = 0.0
-            h[2] = -w * l0 - max(t_end, 1e-9 * w * l0)
+            t_low = max(t_end, 1e-9 * w * l0)
+            h[2] = -w * l0 - t_low if c[2] < 0.0 else t_low
             if partial_solution(h[0], h[1], h[2], w, ea, l0, ls, lf, k0, k1, d, f, True):
                 for m in range(6):
                     fout[m] = f[m]
