@@ -362,16 +362,13 @@ def _solve_from(c, l0, ea, w, ls, lf, k0, k1, h, use_h, tol, max_iter, fout, kou
         # Δz = L0 - 2 s* + L0 (V + w L0/2)/EA, linear in V; no lateral stiffness.
         fzz = 2.0 / w + l0 / ea
         v = (c[2] - l0 - 0.5 * w * l0 * l0 / ea) / fzz
-        # hanging straight with its tension vanishing at its lower end (the free end of a
-        # hanging chain, whose static solve leaves it folded by 1e-11 to 1e-9 m: the fold's
-        # axial stiffness is only w/2). Newton met T = 0 at that end. Where the chord is
-        # within 1e-6 of L0 of the hanging length L0 + w L0²/(2 EA), the element is taken as
-        # hanging straight with the tension EA (|Δz| - that length) / L0 at its lower end, at
-        # least 1e-9 of its weight (the lateral stiffness falls only as 1 / log of it), not
-        # as folded, whose lateral stiffness is zero (a spurious zero mode at a chain's free
-        # end; tester t78)
-        # (its lower end is j where the chord points down, i where it points up: h is the
-        # force at i along the chord, -(w L0 + T_j) or +T_i)
+        # Hanging straight, its tension vanishing at its lower end (a hanging chain's free
+        # end, which the static solve leaves folded by 1e-11 to 1e-9 m: the fold's axial
+        # stiffness is only w/2), where Newton met T = 0: within 1e-6 L0 of the hanging length
+        # L0 + w L0²/(2 EA), taken as hanging with the tension EA (|Δz| - that) / L0 at its
+        # lower end (j if the chord points down, i if up), at least 1e-9 of its weight (the
+        # lateral stiffness falls as 1 / log of it), not folded with no lateral stiffness (a
+        # spurious zero mode at the free end; tester t78). h: -(w L0 + T_j) or +T_i.
         t_end = ea * (abs(c[2]) - l0 - 0.5 * w * l0 * l0 / ea) / l0
         if abs(t_end) <= 1e-6 * ea:
             h[0] = 0.0

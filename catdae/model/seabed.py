@@ -88,6 +88,15 @@ class GroundedElements:
         g.position_batch(np.ascontiguousarray(h, float), b.w, b.EA, b.L0, self.mode, sarr, out)
         return out
 
+    def position_in(self, e: int, h_e, s: float) -> np.ndarray:
+        """x(s) - x_i of element ``e`` alone (catdae.element.elements.Elements.position_in),
+        on the seabed where it lies."""
+        b = self.base
+        out = np.array(b.position_in(e, h_e, s), float).reshape(1, 1, 3)
+        g.position_batch(np.array(h_e, float).reshape(1, 3), b.w[e:e + 1], b.EA[e:e + 1],
+                         b.L0[e:e + 1], self.mode[e:e + 1], np.full((1, 1), float(s)), out)
+        return out[0, 0]
+
     def lying_length(self, h) -> np.ndarray:
         """Unstrained length of each element resting on the seabed, (n,) m."""
         b = self.base
