@@ -320,3 +320,33 @@ def test_the_catdae_command_is_the_entry_that_ends_fast_and_stops_quietly(tmp_pa
                           timeout=300)
     assert proc.returncode == 130
     assert proc.stderr.strip() == "catdae: interrupted while starting (nothing was computed)"
+
+
+def test_the_summary_of_a_net_names_its_extremes_not_every_cable():
+    """A net of 60 cables (a 7x7 grid's inner lines, 5 m segments, edges held) printed a
+    line pair per cable (a 25x25 net: 5 206 lines; tester t77). Above 20 cables the summary
+    gives the cable of the largest end tension and of the largest sag, each as computed from
+    the results here, and says how many more there are."""
+    from catdae.output.summary import step_summary
+
+    n = 7
+    nodes = {f"N{i}_{j}": (5.0 * i, 5.0 * j, 0.0) for i in range(n) for j in range(n)}
+    edge = [k for k in nodes if {"0", str(n - 1)} & set(k[1:].split("_"))]
+    cables = "".join(
+        f'[[cables]]\nname = "{a}-{b}"\nends = ["{a}", "{b}"]\nmaterial = "m"\n'
+        f"length = 5.01\nelements = 2\n"
+        for i in range(1, n - 1) for j in range(n - 1)
+        for a, b in ((f"N{i}_{j}", f"N{i}_{j + 1}"), (f"N{j}_{i}", f"N{j + 1}_{i}")))
+    from scene_toml import scene, static_step
+
+    text = scene(materials={"m": {"EA": 1.0e6, "mass": 1.0}}, nodes=nodes,
+                 supports=tuple(edge), cables=cables, steps=static_step("st"))
+    ds = catdae.run(catdae.load_case(text))["st"].ds
+    assert ds.cable.size == 60 > 20
+    printed = step_summary("st", ds)
+    big_t = str(ds.cable.values[int(np.argmax(ds.cable_end_tension.values.max(axis=1)))])
+    big_sag = str(ds.cable.values[int(np.argmax(ds.sag.values))])
+    named = [line.split(":")[0].split()[-1] for line in printed.splitlines()
+             if line.startswith("    cable ")]
+    assert set(named) == {big_t, big_sag}, named
+    assert f"... {60 - len(named)} more cables" in printed
