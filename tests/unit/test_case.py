@@ -338,6 +338,8 @@ def test_malformed_toml_gives_line_and_column():
     ({"steps/1/max_order": 6}, "steps[1].max_order", ['"auto" or an integer from 1 to 5']),
     # rtol = 5 (a slip for 5e-3) reported 4.5e9 N for 12 kN, status completed (a tester)
     ({"steps/1/rtol": 5.0}, "steps[1].rtol", ["expected a value <= 0.1", "5.0"]),
+    # digits a double does not hold (tester t75: 1.8 million steps for 0.68 s, no word)
+    ({"steps/1/rtol": 1e-15}, "steps[1].rtol", ["expected a value >= 1e-13", "1e-15"]),
     ({"steps/1/max_order": "fast"}, "steps[1].max_order", ['"auto"', "'fast'"]),
     ({"steps/1/linear_solver": "bandd"}, "steps[1].linear_solver", ["did you mean 'band'"]),
     ({"steps/0/kind": "statik"}, "steps[0].kind", ["did you mean 'static'"]),
