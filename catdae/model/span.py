@@ -52,8 +52,6 @@ def span_quantities(model, X: np.ndarray, state) -> dict[str, np.ndarray]:
         for key, value in _one_cable(model, X, state, els, s, pts[els]).items():
             out[key][ci] = value
         out["tension_max"][ci] = float(tens[els].max())
-    if not getattr(model.case, "gravity", 1.0):  # no vertical to swing from (tester t77: 90°)
-        out["swing_angle"][:] = np.nan
     ground = getattr(model.case, "ground", None)
     if ground is not None:
         out.update(clearances(model, X, state, ground, s, pts))

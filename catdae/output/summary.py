@@ -210,8 +210,8 @@ def _span_lines(ds, k: int) -> list[str]:
         parts = ["the largest sag is at midspan" if same else
                  f"sag at midspan {mid:.6g} m" + (" (above the chord: the cable bulges up)"
                                                    if mid < 0 else ""),
-                 f"lowest point {low:.6g} m below the lower end"]
-        parts += [f"swing angle {_deg(swing)} deg"] if np.isfinite(swing) else []  # g = 0
+                 f"lowest point {low:.6g} m below the lower end",
+                 f"swing angle {_deg(swing)} deg"]
     parts += _rated(ds, k) + _seabed_part(ds, k)
     if "clearance" in ds:
         parts.append(f"clearance above the ground {float(ds.clearance.values[k]):.6g} m at "

@@ -26,7 +26,7 @@ from catdae.output import plot_spans
 
 from reference import irvine_catenary
 from repo_paths import CASES
-from scene_toml import cable, cable_scene, load, scene, static_step
+from scene_toml import cable, cable_scene, scene, static_step
 from scene_toml import step as step_block
 
 G = 9.81
@@ -291,17 +291,3 @@ def test_a_swept_static_step_is_labelled_by_its_values_in_the_spans_figure():
     exact = [level_span(301.0, 3.0e7, 1.6 * G + 15.0 * f, 0.0, 300.0)[0] for f in (0.5, 1.0)]
     # the ice as loads at Gauss points converges as h² to Irvine's (2.3e-4 at 8 elements)
     np.testing.assert_allclose(drawn["c|sag_midspan"].get_ydata(), exact, rtol=5e-4)
-
-
-def test_without_gravity_no_swing_angle_is_given():
-    """The swing angle is measured from the vertical, which gravity 0 does not have: a string
-    pulled sideways printed "swing angle 90 deg" (tester t77). NaN, and not printed."""
-    from catdae.output.summary import step_summary
-
-    text = cable_scene(B=(10.0, 0.0, 0.0), L0=10.0, EA=1.0e4, mass=1.0, elements=4,
-                       gravity=0.0, extra=load("p", [0.0, 20.0, 0.0], node="c.2"),
-                       steps=static_step("st"))
-    ds = catdae.run(catdae.load_case(text))["st"].ds
-    assert np.isnan(ds.swing_angle.values).all()
-    assert float(np.abs(ds.position.sel(axis="y")).max()) > 0.1  # it was pulled sideways
-    assert "swing angle" not in step_summary("st", ds)
