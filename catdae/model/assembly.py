@@ -77,18 +77,18 @@ class Model(MassMatrices):
     """What one analysis step sees: mesh, active loading, supports and their motion."""
 
     def __init__(self, case: Case, mesh: Mesh, absent: set[str], mass_model: str = "auto",
-                 kind: str = "transient", snap: str = ""):
+                 kind: str = "transient", snap: str = "", rerun: bool = False):
         """``absent``: names of the point masses and loads not present in this step;
         ``mass_model`` "auto" is resolved for a step of ``kind`` into ``self.mass_model``, a
         :class:`~catdae.model.settings.MassModel` that says which and why (``snap``: why a
-        transient can snap, catdae.model.snap)."""
+        transient can snap, catdae.model.snap; ``rerun``: found by a first run)."""
         self.case = case
         self.mesh = mesh
         self.absent = frozenset(absent)
         self.loading = build_loading(case, mesh, absent)
         ends = (free_hanging_ends(case, mesh, self.loading.node_mass) if mass_model == "auto"
                 else [])
-        self.mass_model = choose_mass_model(mass_model, kind, ends, snap)
+        self.mass_model = choose_mass_model(mass_model, kind, ends, snap, rerun)
         # springs, dampers, bars (None when the scene has none); bar weights and lumped
         # masses go into the loading
         self.connectors = build_connectors(case, mesh, self.loading)

@@ -25,6 +25,7 @@ class MassModel:
     setting: str = "set by the step"
     choice: str = "set by the step"
     snap: str = ""  # why "auto" took a wave-carrying mass for a transient that can snap
+    rerun: bool = False  # taken after a first run with a catenary mass (solvers/auto_rerun.py)
 
     @property
     def lumped_fraction(self) -> float:
@@ -69,7 +70,8 @@ class MassModel:
         return hash((self.name, self.setting, self.choice))
 
 
-def choose_mass_model(setting: str, kind: str, ends: list[str], snap: str = "") -> MassModel:
+def choose_mass_model(setting: str, kind: str, ends: list[str], snap: str = "",
+                      rerun: bool = False) -> MassModel:
     """The mass model of a step: ``setting`` as given, or for ``"auto"`` (the default,
     docs/case-format.md, mass_model) "blended", except with a free-hanging end (``ends``, from
     ``catdae.model.loading.free_hanging_ends``): "consistent" for a modal step (the blend's
@@ -77,12 +79,13 @@ def choose_mass_model(setting: str, kind: str, ends: list[str], snap: str = "") 
     mode), "lumped" for a transient step (the consistent part breaks causality and the
     work-energy balance there; tests/scenes/test_extremes.py measures both). ``snap``: why a
     transient step can snap (``catdae.model.snap.snap_reason``; "" if it cannot): "lumped" then
-    too, a mass that carries the axial wave of a snap (docs/theory.md §18.5)."""
+    too, a mass that carries the axial wave of a snap (docs/theory.md §18.5); ``rerun``: found
+    by a first run with a catenary mass (catdae.solvers.auto_rerun)."""
     if setting != "auto":
         return MassModel(setting, setting, "set by the step")
     if snap and kind == "transient":
         return MassModel("lumped", setting, f"auto: lumped (a transient that can snap: {snap})",
-                         snap)
+                         snap, rerun)
     if not ends:
         return MassModel("blended", setting, "auto: blended (no free-hanging end)")
     shown = ", ".join(ends[:3]) + (f" and {len(ends) - 3} more" if len(ends) > 3 else "")

@@ -87,8 +87,9 @@ def strain_note(ds: xr.Dataset, case) -> str:
         return ""
     top = np.asarray(var.max("time").values if "time" in var.dims else var.values, float)
     said = []
-    for name in dict.fromkeys(str(c) for c in ds.element_cable.values):
-        t, ea = float(np.nanmax(top[ds.element_cable.values == name])), case.material_of(name).EA
+    names = list(dict.fromkeys(str(c) for c in ds.element_cable.values))
+    for name, t in zip(names, cable_max(ds, top, names), strict=True):
+        ea = case.material_of(name).EA
         if t > MAX_STRAIN * ea:
             said.append(f"cable {name!r} reached a strain of {100 * t / ea:.3g} % (tension "
                         f"{t:.4g} N, T / EA), far beyond what a cable carries and the "
@@ -96,6 +97,17 @@ def strain_note(ds: xr.Dataset, case) -> str:
                         "case that needs more is refused when read): check the loads, the "
                         "support motions and their units")
     return "; ".join(said)
+
+
+def cable_max(ds: xr.Dataset, top: np.ndarray, cables: list[str]) -> np.ndarray:
+    """Per cable (in ``cables`` order) the largest of ``top`` (element, end), NaN where it has
+    none: one pass over the elements (a mask per cable was cables times elements)."""
+    code = {c: i for i, c in enumerate(cables)}
+    which = np.array([code[str(c)] for c in ds.element_cable.values], dtype=np.intp)
+    out = np.full(len(cables), -np.inf)
+    np.fmax.at(out, which, np.fmax.reduce(np.asarray(top, float).reshape(len(which), -1),
+                                           axis=1))
+    return np.where(np.isfinite(out), out, np.nan)
 
 
 def _limit_note(ds: xr.Dataset, data: dict) -> str:
@@ -239,9 +251,8 @@ def add_transient(ds: xr.Dataset, case, reference: xr.Dataset | None = None,
     if np.isfinite(rated).any():
         # the envelope of every accepted step (a peak between outputs counts), else the outputs
         top = (ds.tension_max if "tension_max" in ds else ds.tension.max("time")).values
-        t_max = [float(top[ds.element_cable.values == c].max()) for c in cables]
         data["tension_percent_rated"] = _cable_var(
-            100.0 * np.array(t_max) / rated, "percent",
+            100.0 * cable_max(ds, top, cables) / rated, "percent",
             "largest tension along the cable during the step (its tension_max envelope) as a "
             "percentage of the material's rated_strength")
     out = ds.assign_coords(cable=xr.Variable("cable", np.array(cables, dtype=object),

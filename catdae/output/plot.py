@@ -32,7 +32,7 @@ from catdae.output.plot_envelopes import mark_peaks, reactions
 from catdae.output.plot_parts import PlotError, draw_connectors, label, legend
 from catdae.output.plot_parts import output_times as _times
 from catdae.output.plot_parts import subplots as _subplots
-from catdae.output.reading import ratio_text
+from catdae.output.reading import cable_paths, ratio_text
 
 WHAT = ("profile", "history", "spectrum", "tension", "modes", "spans", "reactions")
 
@@ -66,15 +66,6 @@ def _ds(data, figure: str | None = None) -> xr.Dataset:
             raise PlotError(f"the step has no outputs to draw (status: "
                             f"{str(data.attrs.get('status', ''))[:80]})")
     return data
-
-
-def cable_paths(ds: xr.Dataset) -> dict[str, list[str]]:
-    """Node labels of each cable from its first end to its last (from element_node)."""
-    paths = {}
-    for cab in dict.fromkeys(str(c) for c in ds.element_cable.values):
-        nodes = ds.element_node.values[ds.element_cable.values == cab]  # (n, 2), in order
-        paths[cab] = [str(n) for n in nodes[:, 0]] + [str(nodes[-1, 1])]
-    return paths
 
 
 def _paths(ds: xr.Dataset) -> dict[str, list[str]]:

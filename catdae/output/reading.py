@@ -86,6 +86,15 @@ def step_values(name: str, ds: xr.Dataset) -> list[tuple[str, xr.Dataset]]:
     return out
 
 
+def cable_paths(ds: xr.Dataset) -> dict[str, list[str]]:
+    """Node labels of each cable from its first end to its last (from element_node)."""
+    paths = {}
+    for cab in dict.fromkeys(str(c) for c in ds.element_cable.values):
+        nodes = ds.element_node.values[ds.element_cable.values == cab]  # (n, 2), in order
+        paths[cab] = [str(n) for n in nodes[:, 0]] + [str(nodes[-1, 1])]
+    return paths
+
+
 def join_values(groups: list[xr.Dataset]) -> tuple[xr.Dataset, list[str]]:
     """The groups of a sweep's values as one along ``sweep`` (the inverse of
     :func:`step_values`): attributes that differ between the values, or that some lack, become
@@ -110,9 +119,9 @@ def per_value(ds: xr.Dataset, fn) -> xr.Dataset:
     parts = []
     for _, one in step_values("", ds):
         one.attrs.pop("sweep_value", None)
-        one.attrs["title"] = ds.attrs.get("title", "")
-        if "title" not in ds.attrs:
-            del one.attrs["title"]
+        one.attrs.pop("title", None)  # step_values's per-value title: the group's own kept
+        if "title" in ds.attrs:
+            one.attrs["title"] = ds.attrs["title"]
         parts.append(fn(one))
     out, varying = join_values(parts)
     listed = set(str(ds.attrs.get("sweep_attributes", "")).split())

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from catdae._xr import xr
+from catdae.output.reading import cable_paths
 
 JUMP_ANGLE = 135.0  # degrees: past it the cable is above its chord more than beside it
 
@@ -55,11 +56,10 @@ def swing_over_time(ds: xr.Dataset, cables: list[str],
     up = up / np.linalg.norm(up)
     X = np.asarray(ds.position.transpose("time", "node", "axis").values, float)
     index = {str(n): i for i, n in enumerate(ds.node.values)}
+    paths = cable_paths(ds)
     angle = np.full((X.shape[0], len(cables)), np.nan)
     for ci, c in enumerate(cables):
-        ends = ds.element_node.values[ds.element_cable.values == c]  # (n, 2), in order
-        order = [index[str(n)] for n in ends[:, 0]] + [index[str(ends[-1, 1])]]
-        angle[:, ci] = _swing(X[:, order], up)
+        angle[:, ci] = _swing(X[:, [index[n] for n in paths[c]]], up)
     found = np.isfinite(angle).any(axis=0)
     k = np.argmax(np.where(np.isfinite(angle), angle, -np.inf), axis=0)
     top = np.where(found, angle[k, np.arange(len(cables))], np.nan)

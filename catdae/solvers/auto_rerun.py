@@ -76,7 +76,7 @@ def run_transient_auto(step, model: Model, state, writer, progress):
     first = {k: rec.attrs.get(k, 0) for k in ("n_steps", "wall_time")}
     state.X, state.V, state.h, state.t = start
     lumped = Model(model.case, model.mesh, model.absent, mass_model="auto", kind=step.kind,
-                   snap=why)
+                   snap=why, rerun=True)
     rec = run_transient(step, lumped, state, writer, progress)
     rec.attrs.update(n_steps_discarded=first["n_steps"], wall_time_discarded=first["wall_time"])
     state.snap = step.name  # a transient that continues it keeps the lumped mass

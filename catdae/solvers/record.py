@@ -186,9 +186,9 @@ def _slack_note(model: Model, rec: OutputRecord | None, n_valid: int) -> str:
 def _mass_note(model: Model, prob) -> str:
     if model.mass_model.snap:
         why = model.mass_model.snap
-        advice = ("set mass_model = \"lumped\" on the step to save that first run" if "first run"
-                  in why else "give mass_model = \"blended\" where no snap is expected "
-                  "(smooth motion converges faster with it; docs/accuracy.md)")
+        advice = ("set mass_model = \"lumped\" on the step to save that first run"
+                  if model.mass_model.rerun else "give mass_model = \"blended\" where no snap "
+                  "is expected (smooth motion converges faster with it; docs/accuracy.md)")
         return ("mass_model \"auto\" chose \"lumped\", a mass that carries axial (snap) waves, "
                 f"because {why}; {advice}")
     if not model.mass_model.catenary:

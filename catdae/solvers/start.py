@@ -49,13 +49,15 @@ class ConsistentStart:
         if where == "transient start":  # for the note on loads that come or go (snaps)
             X = self.X.reshape(-1, 3)
             self.lambda2_start = float(m.element_lambda2(conf[0], X).max(initial=0.0))
-            # the force out of balance at the start, against the largest tension: a load
-            # removed whose time function is 0 there changes nothing (tester t75)
-            full_v = np.zeros(X.shape)
-            full_v.reshape(-1)[self.fidx] = v0
-            self.unbalance_start = float(np.linalg.norm(unbalance_forces(
-                m, conf[0], X, t0, full_v), axis=1).max(initial=0.0)) / max(
-                float(m.tensions(conf[0]).max(initial=0.0)), 1e-300)
+            # the force out of balance at the start, against the largest tension, where the
+            # step adds or removes something (the note's only use): a load removed whose time
+            # function is 0 there changes nothing (tester t75)
+            if self.step.add or self.step.remove:
+                full_v = np.zeros(X.shape)
+                full_v.reshape(-1)[self.fidx] = v0
+                self.unbalance_start = float(np.linalg.norm(unbalance_forces(
+                    m, conf[0], X, t0, full_v), axis=1).max(initial=0.0)) / max(
+                    float(m.tensions(conf[0]).max(initial=0.0)), 1e-300)
         vs_after = self._supports(t0)[1]
         dvs = vs_after - vs_before
         # a jump, not the round-off of two evaluations of a smooth motion

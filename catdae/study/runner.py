@@ -24,6 +24,7 @@ from catdae.errors import CaseError
 from catdae.interrupts import deferred
 from catdae.study.core import (
     COUNTS,
+    SETTINGS,
     StudyError,
     common_points,
     configure,
@@ -197,8 +198,7 @@ def _modal_target(st: Step, response) -> int:
 
 
 # the settings a study may change: a reference differing only there is of the same scene
-_SETTINGS_KEYS = {"rtol", "atol", "mass_model", "max_order", "linear_solver", "gauss_points",
-                  "duration", "output_interval", "elements"}
+_SETTINGS_KEYS = {*SETTINGS, "duration", "output_interval"}
 
 
 def _scene_differences(tree: xr.DataTree, case: Case) -> list[str]:

@@ -34,6 +34,7 @@ from scene_toml import (
     modal_step,
     point_mass,
     scene,
+    section,
     static_step,
     step,
     support_motion,
@@ -108,9 +109,11 @@ def test_point_load_or_mass_inside_element_matches_two_segment_catenary(ne, what
 def test_the_lowest_point_is_a_kink_just_beside_a_node(ne, s1):
     """A 20 kN load 0.03-0.1 m from a node (tester t74): the cable's lowest point is the kink
     under the load; `sag_lowest_point` read the node's height (1-2.8 cm high), the search
-    refining only the element of the node's sample. Against two catenary segments."""
+    refining only the element of the node's sample; the clearance above a level ground the
+    same (one search serves both). Against two catenary segments."""
     L0, EA, m, F, span, rise = 160.0, 2.0e7, 8.0, 2.0e4, 150.0, 30.0
-    extra = load("P", [0.0, 0.0, -F], cable="c", s=s1)
+    # over a level ground 20 m down: the clearance is least at the kink too
+    extra = load("P", [0.0, 0.0, -F], cable="c", s=s1) + section("ground", elevation=-20.0)
     ds = catdae.run(single_span((span, 0.0, rise), L0, EA, m, ne, extra))["st"].ds
     w = m * G
 
@@ -126,6 +129,8 @@ def test_the_lowest_point_is_a_kink_just_beside_a_node(ne, s1):
     assert float(ds.lowest_point_elevation.item()) == pytest.approx(kink, abs=1e-8)
     assert float(ds.sag_lowest_point.item()) == pytest.approx(-kink, abs=1e-8)
     assert float(ds.lowest_point_s.item()) == pytest.approx(s1, abs=1e-6)
+    assert float(ds.clearance.item()) == pytest.approx(kink + 20.0, abs=1e-8)
+    assert float(ds.clearance_s.item()) == pytest.approx(s1, abs=1e-6)
 
 
 def test_roller_support_pulled_horizontally_carries_exactly_the_pull():
